@@ -1,0 +1,17 @@
+// Each subcommand of `slamo` lives in its own file and registers itself on the app here;
+// autonomy/main.cc only dispatches.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace slamo::autonomy {
+
+// A registered subcommand runs this after parsing; it returns the process exit status.
+using CommandAction = std::function<int()>;
+
+// `slamo field list|check|show`.
+void RegisterFieldCommand(CLI::App& app, CommandAction* action);
+
+}  // namespace slamo::autonomy

@@ -1,0 +1,39 @@
+// `slamo`: one program, one subcommand per file under autonomy/commands/. This file only
+// builds the command line and dispatches; bad configuration exits with status 2.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "autonomy/commands/commands.h"
+#include "field_configs/config_error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"slamo: SLAM-O autonomy for VEX Robotics Competition robots"};
+  app.require_subcommand(1);
+  app.footer(
+      "Examples:\n"
+      "  slamo field list                          the shipped seasons\n"
+      "  slamo field check toss_up                 validate a season and summarise it\n"
+      "  slamo field show toss_up --out f.png      draw the field from above");
+
+  slamo::autonomy::CommandAction action;
+  slamo::autonomy::RegisterFieldCommand(app, &action);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+
+  try {
+    return action ? action() : 0;
+  } catch (const slamo::field::ConfigError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+}
