@@ -149,7 +149,19 @@ void FieldCanvas::DrawGoals() {
   for (const field::Goal& g : season_.goals) {
     const cv::Scalar colour = AllianceColour(g.alliance);
     const cv::Point center = ToPixel(g.center_m.x, g.center_m.y);
-    if (g.kind == field::GoalKind::kZone && g.shape == SolidShape::kBox) {
+    if (g.shape == SolidShape::kBox && g.yaw_deg != 0.0) {
+      // A rotated goal or zone: its outline, turned.
+      const double yaw = g.yaw_deg * M_PI / 180.0;
+      std::vector<cv::Point> corners;
+      for (const auto& [u, v] :
+           std::vector<std::pair<double, double>>{{1, 1}, {-1, 1}, {-1, -1}, {1, -1}}) {
+        const double lx = u * g.size_m.x / 2.0, ly = v * g.size_m.y / 2.0;
+        corners.push_back(ToPixel(g.center_m.x + std::cos(yaw) * lx - std::sin(yaw) * ly,
+                                  g.center_m.y + std::sin(yaw) * lx + std::cos(yaw) * ly));
+      }
+      cv::polylines(image_, corners, true, colour, g.kind == field::GoalKind::kGoal ? 3 : 2,
+                    cv::LINE_AA);
+    } else if (g.kind == field::GoalKind::kZone && g.shape == SolidShape::kBox) {
       const Vec2 half{g.size_m.x / 2.0, g.size_m.y / 2.0};
       DashedRectangle(image_, ToPixel(g.center_m.x - half.x + 0.02, g.center_m.y + half.y - 0.02),
                       ToPixel(g.center_m.x + half.x - 0.02, g.center_m.y - half.y + 0.02), colour);

@@ -31,6 +31,14 @@ TEST(LoaderTest, EveryShippedSeasonLoads) {
   }
 }
 
+TEST(LoaderTest, ShipsTheSevenSeasons) {
+  const std::vector<std::string> seasons = ListSeasons();
+  for (const char* name : {"toss_up", "skyrise", "nothing_but_net", "starstruck", "over_under",
+                           "high_stakes", "push_back"}) {
+    EXPECT_NE(std::find(seasons.begin(), seasons.end(), name), seasons.end()) << name;
+  }
+}
+
 TEST(LoaderTest, EveryShippedRobotLoads) {
   const std::vector<std::string> robots = ListRobots();
   ASSERT_FALSE(robots.empty());
