@@ -1,0 +1,268 @@
+#include "platform/drive_script.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+namespace slamo::platform {
+namespace {
+
+std::string Trim(const std::string& text) {
+  const auto not_space = [](unsigned char c) { return !std::isspace(c); };
+  const auto begin = std::find_if(text.begin(), text.end(), not_space);
+  const auto end = std::find_if(text.rbegin(), text.rend(), not_space).base();
+  return begin < end ? std::string(begin, end) : std::string();
+}
+
+[[noreturn]] void Fail(int index, const std::string& statement, const std::string& problem) {
+  throw DriveScriptError("drive script statement " + std::to_string(index) + " \"" + statement +
+                         "\": " + problem);
+}
+
+// The whole token as a finite number, or a DriveScriptError naming it.
+double ParseNumber(int index, const std::string& statement, const std::string& token,
+                   const std::string& what) {
+  double value = 0.0;
+  size_t used = 0;
+  try {
+    value = std::stod(token, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != token.size() || !std::isfinite(value)) {
+    Fail(index, statement, "expected " + what + ", got \"" + token + "\"");
+  }
+  return value;
+}
+
+DriveStep ParseStatement(int index, const std::string& statement) {
+  std::istringstream in(statement);
+  std::vector<std::string> tokens;
+  for (std::string token; in >> token;) tokens.push_back(token);
+  const std::string& verb = tokens[0];
+  if (verb != "forward" && verb != "back" && verb != "turn" && verb != "wait") {
+    Fail(index, statement,
+         "unknown command \"" + verb + "\" (expected forward, back, turn or wait)");
+  }
+  const std::string what = verb == "turn"   ? "an angle in degrees"
+                           : verb == "wait" ? "a time in seconds"
+                                            : "a distance in metres";
+  if (tokens.size() < 2) Fail(index, statement, "missing " + what + " after \"" + verb + "\"");
+  if (tokens.size() > 2) Fail(index, statement, "unexpected \"" + tokens[2] + "\"");
+  const double value = ParseNumber(index, statement, tokens[1], what);
+
+  DriveStep step;
+  step.text = statement;
+  step.amount = value;
+  if (verb == "turn") {
+    step.kind = DriveStepKind::kTurn;
+  } else if (verb == "wait") {
+    if (value < 0.0) Fail(index, statement, "expected a time >= 0, got \"" + tokens[1] + "\"");
+    step.kind = DriveStepKind::kWait;
+  } else {
+    if (value <= 0.0) {
+      Fail(index, statement, "expected a distance > 0, got \"" + tokens[1] + "\"");
+    }
+    step.kind = DriveStepKind::kDrive;
+    if (verb == "back") step.amount = -value;
+  }
+  return step;
+}
+
+// The controller: runs in lockstep with the simulator and sees only its encoders.
+class Runner {
+ public:
+  Runner(const DriveControllerOptions& options, SimDriveBase* sim, SimClock* clock)
+      : options_(options),
+        sim_(sim),
+        clock_(clock),
+        half_track_m_(0.5 * sim->drive().track_width_m),
+        odometry_(sim->metres_per_tick(), sim->drive().track_width_m, sim->ReadEncoders(),
+                  sim->odometry_pose()),
+        heading_rad_(odometry_.pose().theta_rad),
+        intended_heading_rad_(heading_rad_) {}
+
+  DriveStepResult Run(const DriveStep& step) {
+    DriveStepResult result;
+    result.step = step;
+    bool done = true;
+    switch (step.kind) {
+      case DriveStepKind::kTurn: {
+        const double amount_rad = step.amount * kPi / 180.0;
+        intended_heading_rad_ += amount_rad;
+        const double nominal_s = std::abs(amount_rad) * half_track_m_ / options_.cruise_speed_mps;
+        done = Turn(intended_heading_rad_ - heading_rad_, Deadline(nominal_s));
+        break;
+      }
+      case DriveStepKind::kDrive: {
+        const double nominal_s = std::abs(step.amount) / options_.cruise_speed_mps;
+        done = Drive(step.amount, Deadline(nominal_s));
+        break;
+      }
+      case DriveStepKind::kWait: {
+        sim_->Stop();
+        const long ticks = std::lround(step.amount / options_.control_dt_s);
+        for (long i = 0; i < ticks; ++i) Tick();
+        break;
+      }
+    }
+    result.status = done ? DriveStepStatus::kDone : DriveStepStatus::kTimedOut;
+    result.end_time_s = clock_->NowS();
+    result.true_pose = sim_->true_pose();
+    result.odometry_pose = odometry_.pose();
+    return result;
+  }
+
+ private:
+  double Deadline(double nominal_s) const {
+    return clock_->NowS() + options_.timeout_factor * nominal_s + options_.timeout_margin_s;
+  }
+
+  // One controller period: simulator and clock advance together, then the encoders are read.
+  void Tick() {
+    sim_->Step(options_.control_dt_s);
+    clock_->Advance(options_.control_dt_s);
+    const double before_rad = odometry_.pose().theta_rad;
+    odometry_.Update(sim_->ReadEncoders());
+    heading_rad_ += WrapAngleRad(odometry_.pose().theta_rad - before_rad);
+  }
+
+  // The next wheel speed of a ramp: accelerate to cruise, decelerate to reach 0 at the end.
+  double RampSpeed(double speed_mps, double remaining_m) const {
+    return std::min({speed_mps + options_.accel_mps2 * options_.control_dt_s,
+                     options_.cruise_speed_mps,
+                     std::sqrt(2.0 * options_.accel_mps2 * std::max(0.0, remaining_m))});
+  }
+
+  // Turns in place by amount_rad by the encoders; false on timeout.
+  bool Turn(double amount_rad, double deadline_s) {
+    const double target_rad = heading_rad_ + amount_rad;
+    const double sign = amount_rad >= 0.0 ? 1.0 : -1.0;
+    double speed_mps = 0.0;
+    while (true) {
+      const double remaining_m = sign * (target_rad - heading_rad_) * half_track_m_;
+      if (remaining_m <= speed_mps * options_.stop_lead_s) break;
+      if (clock_->NowS() >= deadline_s) {
+        Settle();
+        return false;
+      }
+      speed_mps = RampSpeed(speed_mps, remaining_m);
+      sim_->SetSpeedTargets(-sign * speed_mps, sign * speed_mps);
+      Tick();
+    }
+    Settle();
+    return true;
+  }
+
+  // Turn-then-drive: aligns with the intended heading, then drives distance_m (negative =
+  // backwards) holding it; false on timeout.
+  bool Drive(double distance_m, double deadline_s) {
+    const double misalignment_rad = intended_heading_rad_ - heading_rad_;
+    if (std::abs(misalignment_rad) > options_.align_tolerance_deg * kPi / 180.0) {
+      if (!Turn(misalignment_rad, deadline_s)) return false;
+    }
+    const Pose2D start = odometry_.pose();
+    const double ux = std::cos(intended_heading_rad_);
+    const double uy = std::sin(intended_heading_rad_);
+    const double sign = distance_m >= 0.0 ? 1.0 : -1.0;
+    double speed_mps = 0.0;
+    while (true) {
+      const Pose2D& pose = odometry_.pose();
+      const double along_m = (pose.x_m - start.x_m) * ux + (pose.y_m - start.y_m) * uy;
+      const double remaining_m = std::abs(distance_m) - sign * along_m;
+      if (remaining_m <= speed_mps * options_.stop_lead_s) break;
+      if (clock_->NowS() >= deadline_s) {
+        Settle();
+        return false;
+      }
+      speed_mps = RampSpeed(speed_mps, remaining_m);
+      // Hold the heading: a yaw-rate command becomes a wheel speed difference.
+      const double yaw_rate_rps =
+          options_.heading_gain_per_s * (intended_heading_rad_ - heading_rad_);
+      const double steer_mps =
+          std::clamp(yaw_rate_rps * half_track_m_, -0.5 * speed_mps, 0.5 * speed_mps);
+      sim_->SetSpeedTargets(sign * speed_mps - steer_mps, sign * speed_mps + steer_mps);
+      Tick();
+    }
+    Settle();
+    return true;
+  }
+
+  // Stops and waits until the encoders have been still for settle_s (or max_settle_s).
+  void Settle() {
+    sim_->Stop();
+    double still_s = 0.0;
+    for (double waited_s = 0.0; still_s < options_.settle_s && waited_s < options_.max_settle_s;
+         waited_s += options_.control_dt_s) {
+      const EncoderTicks before = odometry_.last();
+      Tick();
+      const bool moved =
+          odometry_.last().left != before.left || odometry_.last().right != before.right;
+      still_s = moved ? 0.0 : still_s + options_.control_dt_s;
+    }
+  }
+
+  DriveControllerOptions options_;
+  SimDriveBase* sim_;
+  SimClock* clock_;
+  double half_track_m_;
+  EncoderOdometry odometry_;
+  double heading_rad_;           // odometry heading, unwrapped
+  double intended_heading_rad_;  // sum of the script's turns, unwrapped
+};
+
+}  // namespace
+
+std::vector<DriveStep> ParseDriveScript(const std::string& script) {
+  std::vector<DriveStep> steps;
+  std::string statement;
+  int index = 0;
+  const auto flush = [&]() {
+    const std::string trimmed = Trim(statement);
+    statement.clear();
+    if (trimmed.empty()) return;
+    steps.push_back(ParseStatement(++index, trimmed));
+  };
+  for (const char c : script) {
+    if (c == ';' || c == '\n') {
+      flush();
+    } else {
+      statement += c;
+    }
+  }
+  flush();
+  return steps;
+}
+
+DriveControllerOptions DriveControllerOptionsFor(const field::DriveConfig& drive) {
+  DriveControllerOptions options;
+  options.cruise_speed_mps = drive.cruise_speed_mps;
+  options.accel_mps2 = drive.accel_mps2;
+  return options;
+}
+
+std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
+                                            const DriveControllerOptions& options,
+                                            SimDriveBase* sim, SimClock* clock) {
+  Runner runner(options, sim, clock);
+  std::vector<DriveStepResult> results;
+  results.reserve(steps.size());
+  for (const DriveStep& step : steps) results.push_back(runner.Run(step));
+  return results;
+}
+
+std::vector<DriveStepResult> SimulateDriveScript(const std::string& script,
+                                                 const field::RobotConfig& robot,
+                                                 const SimDriveOptions& sim_options, uint64_t seed,
+                                                 const Pose2D& start,
+                                                 std::function<bool(const Pose2D&)> is_free) {
+  const std::vector<DriveStep> steps = ParseDriveScript(script);
+  SimDriveBase sim(robot.drive, sim_options, seed, start);
+  if (is_free) sim.SetFreeSpaceCheck(std::move(is_free));
+  SimClock clock;
+  return RunDriveScript(steps, DriveControllerOptionsFor(robot.drive), &sim, &clock);
+}
+
+}  // namespace slamo::platform

@@ -1,0 +1,81 @@
+// Drive scripts: "forward 0.3; turn 90; back 0.2; wait 1" parsed into steps and driven on the
+// simulated drive base by a closed-loop controller that knows only the encoders (turn, then
+// drive holding heading, with speed ramps), the way the real robot will be driven. After each
+// step the result holds the true pose and the encoder-odometry pose.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "field_configs/robot_config.h"
+#include "platform/clock.h"
+#include "platform/drive_base.h"
+#include "platform/sim_drive.h"
+
+namespace slamo::platform {
+
+// A script that does not parse; the message names the statement and the bad token.
+class DriveScriptError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+enum class DriveStepKind {
+  kDrive,  // straight: amount in metres, negative = backwards ("back")
+  kTurn,   // in place: amount in degrees, counter-clockwise positive
+  kWait,   // stopped: amount in seconds
+};
+
+struct DriveStep {
+  DriveStepKind kind = DriveStepKind::kWait;
+  double amount = 0.0;  // m, deg or s by kind
+  std::string text;     // the statement as written, for reports
+};
+
+// Statements are separated by ';' or newlines; each is one of "forward M", "back M",
+// "turn DEG", "wait S" (M > 0 metres, S >= 0 seconds). Throws DriveScriptError.
+std::vector<DriveStep> ParseDriveScript(const std::string& script);
+
+struct DriveControllerOptions {
+  double cruise_speed_mps = 0.067;   // wheel speed when driving and turning (m/s)
+  double accel_mps2 = 0.5;           // ramp up and down (m/s^2)
+  double control_dt_s = 0.02;        // controller period (s)
+  double heading_gain_per_s = 2.0;   // yaw-rate command per radian of heading error (1/s)
+  double align_tolerance_deg = 1.0;  // a drive turns first if the heading is off by more (deg)
+  double stop_lead_s = 0.05;         // stop this long before the target at the commanded speed (s)
+  double settle_s = 0.1;             // encoders still this long ends a step (s)
+  double max_settle_s = 2.0;         // give up waiting for the wheels to stop after this (s)
+  double timeout_factor = 3.0;       // a step times out after this times its nominal duration...
+  double timeout_margin_s = 10.0;    // ...plus this (s)
+};
+
+// Cruise speed and acceleration from the robot's drive config, other fields defaulted.
+DriveControllerOptions DriveControllerOptionsFor(const field::DriveConfig& drive);
+
+enum class DriveStepStatus { kDone, kTimedOut };
+
+struct DriveStepResult {
+  DriveStep step;
+  DriveStepStatus status = DriveStepStatus::kDone;
+  double end_time_s = 0.0;
+  Pose2D true_pose;      // ground truth from the simulator
+  Pose2D odometry_pose;  // what the encoders say (the controller's dead reckoning)
+};
+
+// Drives `steps` on `sim`, advancing `clock` in lockstep with it. Headings are tracked
+// against the intended heading, so a turn also corrects the previous turn's encoder error.
+std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
+                                            const DriveControllerOptions& options,
+                                            SimDriveBase* sim, SimClock* clock);
+
+// For the command line: parses `script` (throws DriveScriptError), builds the robot's
+// simulated drive base with `sim_options` and `seed` at `start` (collisions through the
+// optional `is_free`, see SimDriveBase::SetFreeSpaceCheck), and runs it.
+std::vector<DriveStepResult> SimulateDriveScript(
+    const std::string& script, const field::RobotConfig& robot, const SimDriveOptions& sim_options,
+    uint64_t seed, const Pose2D& start = {}, std::function<bool(const Pose2D&)> is_free = nullptr);
+
+}  // namespace slamo::platform

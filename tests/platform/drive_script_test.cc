@@ -1,0 +1,210 @@
+#include "platform/drive_script.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "field_configs/loader.h"
+
+namespace slamo::platform {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / kPi;
+
+TEST(ParseDriveScriptTest, ParsesAllCommands) {
+  const std::vector<DriveStep> steps =
+      ParseDriveScript("forward 0.3; turn 90;forward 0.6\n back 0.2 ;turn -90; wait 1.5;");
+  ASSERT_EQ(steps.size(), 6u);
+  EXPECT_EQ(steps[0].kind, DriveStepKind::kDrive);
+  EXPECT_DOUBLE_EQ(steps[0].amount, 0.3);
+  EXPECT_EQ(steps[0].text, "forward 0.3");
+  EXPECT_EQ(steps[1].kind, DriveStepKind::kTurn);
+  EXPECT_DOUBLE_EQ(steps[1].amount, 90.0);
+  EXPECT_DOUBLE_EQ(steps[2].amount, 0.6);
+  EXPECT_EQ(steps[3].kind, DriveStepKind::kDrive);
+  EXPECT_DOUBLE_EQ(steps[3].amount, -0.2);
+  EXPECT_DOUBLE_EQ(steps[4].amount, -90.0);
+  EXPECT_EQ(steps[5].kind, DriveStepKind::kWait);
+  EXPECT_DOUBLE_EQ(steps[5].amount, 1.5);
+  EXPECT_TRUE(ParseDriveScript("  ;\n ").empty());
+}
+
+// The message of the DriveScriptError thrown for `script`, or "" if none.
+std::string ErrorOf(const std::string& script) {
+  try {
+    ParseDriveScript(script);
+  } catch (const DriveScriptError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(ParseDriveScriptTest, ErrorsNameTheBadToken) {
+  EXPECT_EQ(ErrorOf("forward 0.3; jump 2"),
+            "drive script statement 2 \"jump 2\": unknown command \"jump\" (expected forward, "
+            "back, turn or wait)");
+  EXPECT_EQ(ErrorOf("turn ninety"),
+            "drive script statement 1 \"turn ninety\": expected an angle in degrees, got "
+            "\"ninety\"");
+  EXPECT_EQ(ErrorOf("forward 0.3m"),
+            "drive script statement 1 \"forward 0.3m\": expected a distance in metres, got "
+            "\"0.3m\"");
+  EXPECT_EQ(ErrorOf("wait"),
+            "drive script statement 1 \"wait\": missing a time in seconds "
+            "after \"wait\"");
+  EXPECT_EQ(ErrorOf("turn 90 left"),
+            "drive script statement 1 \"turn 90 left\": unexpected "
+            "\"left\"");
+  EXPECT_EQ(ErrorOf("back -0.2"),
+            "drive script statement 1 \"back -0.2\": expected a distance "
+            "> 0, got \"-0.2\"");
+  EXPECT_EQ(ErrorOf("wait -1"),
+            "drive script statement 1 \"wait -1\": expected a time >= 0, "
+            "got \"-1\"");
+  EXPECT_NE(ErrorOf("forward nan"), "");
+}
+
+class DriveScriptRunTest : public ::testing::Test {
+ protected:
+  field::RobotConfig robot_ = field::LoadRobotConfig("thesis_robot");
+};
+
+TEST_F(DriveScriptRunTest, DrivesTheScriptByTheEncoders) {
+  const std::vector<DriveStepResult> results = SimulateDriveScript(
+      "forward 0.3; turn 90; forward 0.6; wait 1; back 0.2; turn -90", robot_, {}, 11);
+  ASSERT_EQ(results.size(), 6u);
+  for (const DriveStepResult& result : results) {
+    EXPECT_EQ(result.status, DriveStepStatus::kDone) << result.step.text;
+  }
+  // The encoders say each step was done to within a few millimetres / a degree.
+  EXPECT_NEAR(results[0].odometry_pose.x_m, 0.3, 0.005);
+  EXPECT_NEAR(results[1].odometry_pose.theta_rad * kDegPerRad, 90.0, 1.5);
+  EXPECT_NEAR(results[2].odometry_pose.y_m, 0.6, 0.02);
+  EXPECT_NEAR(results[2].odometry_pose.x_m, 0.3, 0.02);
+  EXPECT_NEAR(results[4].odometry_pose.y_m, 0.4, 0.02);
+  EXPECT_NEAR(results[5].odometry_pose.theta_rad * kDegPerRad, 0.0, 1.5);
+  // Waiting costs time and moves nothing.
+  EXPECT_NEAR(results[3].end_time_s - results[2].end_time_s, 1.0, 0.03);
+  EXPECT_NEAR(results[3].true_pose.x_m, results[2].true_pose.x_m, 1e-4);
+  // Driving 0.3 m at 0.067 m/s takes about 4.5 s plus ramps and settling.
+  EXPECT_GT(results[0].end_time_s, 4.4);
+  EXPECT_LT(results[0].end_time_s, 5.5);
+  // The truth is somewhere else: slip.
+  const double dx = results[2].true_pose.x_m - results[2].odometry_pose.x_m;
+  const double dy = results[2].true_pose.y_m - results[2].odometry_pose.y_m;
+  EXPECT_GT(std::hypot(dx, dy), 0.01);
+}
+
+TEST_F(DriveScriptRunTest, SameSeedSameResult) {
+  const auto a = SimulateDriveScript("forward 0.3; turn 90; forward 0.3", robot_, {}, 42);
+  const auto b = SimulateDriveScript("forward 0.3; turn 90; forward 0.3", robot_, {}, 42);
+  const auto c = SimulateDriveScript("forward 0.3; turn 90; forward 0.3", robot_, {}, 43);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].true_pose.x_m, b[i].true_pose.x_m);
+    EXPECT_EQ(a[i].true_pose.y_m, b[i].true_pose.y_m);
+    EXPECT_EQ(a[i].true_pose.theta_rad, b[i].true_pose.theta_rad);
+    EXPECT_EQ(a[i].odometry_pose.x_m, b[i].odometry_pose.x_m);
+    EXPECT_EQ(a[i].end_time_s, b[i].end_time_s);
+  }
+  EXPECT_NE(a.back().true_pose.x_m, c.back().true_pose.x_m);
+}
+
+TEST_F(DriveScriptRunTest, BlockedRobotSlipsAndFinishesByTheEncoders) {
+  const std::vector<DriveStep> steps = ParseDriveScript("forward 0.3; turn 90");
+  SimDriveBase sim(robot_.drive, SimDriveOptions{}, 3);
+  sim.SetFreeSpaceCheck([](const Pose2D& pose) { return pose.x_m < 0.1; });
+  SimClock clock;
+  DriveControllerOptions options = DriveControllerOptionsFor(robot_.drive);
+  options.timeout_margin_s = 1.0;
+  // The wheels spin against the wall and the encoders count, so the controller believes it
+  // arrived: only the truth shows the robot stuck.
+  const auto results = RunDriveScript(steps, options, &sim, &clock);
+  ASSERT_EQ(results.size(), 2u);
+  EXPECT_EQ(results[0].status, DriveStepStatus::kDone);
+  EXPECT_LT(results[0].true_pose.x_m, 0.1);
+  EXPECT_GT(results[0].odometry_pose.x_m, 0.29);
+}
+
+TEST_F(DriveScriptRunTest, SimulateFromAStartPoseWithAWall) {
+  const Pose2D start{1.0, 2.0, kPi / 2.0};
+  const auto free_run = SimulateDriveScript("forward 0.3", robot_, {}, 5, start);
+  EXPECT_NEAR(free_run[0].odometry_pose.x_m, 1.0, 0.01);
+  EXPECT_NEAR(free_run[0].odometry_pose.y_m, 2.3, 0.005);
+  const auto walled = SimulateDriveScript("forward 0.3", robot_, {}, 5, start,
+                                          [](const Pose2D& pose) { return pose.y_m < 2.1; });
+  EXPECT_LT(walled[0].true_pose.y_m, 2.1);
+  EXPECT_GT(walled[0].odometry_pose.y_m, 2.29);
+}
+
+TEST_F(DriveScriptRunTest, StalledMotorTimesOut) {
+  const std::vector<DriveStep> steps = ParseDriveScript("forward 0.3");
+  SimDriveOptions sim_options;
+  sim_options.left_motor_gain = 0.0;  // motors that do not turn
+  sim_options.right_motor_gain = 0.0;
+  SimDriveBase sim(robot_.drive, sim_options, 3);
+  SimClock clock;
+  DriveControllerOptions options = DriveControllerOptionsFor(robot_.drive);
+  options.timeout_margin_s = 1.0;
+  const auto results = RunDriveScript(steps, options, &sim, &clock);
+  EXPECT_EQ(results[0].status, DriveStepStatus::kTimedOut);
+  // Nominal 0.3 / 0.067 = 4.48 s, times 3, plus 1 s, plus settling.
+  EXPECT_NEAR(clock.NowS(), 3.0 * 0.3 / 0.067 + 1.0, 0.5);
+}
+
+// Drift statistics over many seeds: the calibration the simulator's defaults promise
+// (thesis appendix B: 0.05 m per 0.3 m, 2 deg spread per 90 deg turn, ~0.1 m turn slip).
+struct Stats {
+  double mean = 0.0;
+  double stddev = 0.0;
+};
+Stats StatsOf(const std::vector<double>& values) {
+  Stats stats;
+  for (double v : values) stats.mean += v;
+  stats.mean /= static_cast<double>(values.size());
+  for (double v : values) stats.stddev += (v - stats.mean) * (v - stats.mean);
+  stats.stddev = std::sqrt(stats.stddev / static_cast<double>(values.size() - 1));
+  return stats;
+}
+
+constexpr int kSeeds = 200;
+
+TEST_F(DriveScriptRunTest, StraightDriftMatchesTheThesis) {
+  std::vector<double> position_error_m;
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    const DriveStepResult r = SimulateDriveScript("forward 0.3", robot_, {}, seed).front();
+    position_error_m.push_back(
+        std::hypot(r.true_pose.x_m - r.odometry_pose.x_m, r.true_pose.y_m - r.odometry_pose.y_m));
+  }
+  const Stats stats = StatsOf(position_error_m);
+  std::cout << "straight 0.3 m over " << kSeeds << " seeds: mean |position error| " << stats.mean
+            << " m, std " << stats.stddev << " m\n";
+  EXPECT_GE(stats.mean, 0.03);
+  EXPECT_LE(stats.mean, 0.07);
+}
+
+TEST_F(DriveScriptRunTest, TurnSpreadAndSlipMatchTheThesis) {
+  std::vector<double> heading_error_deg;
+  std::vector<double> centre_travel_m;
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    const DriveStepResult r = SimulateDriveScript("turn 90", robot_, {}, seed).front();
+    heading_error_deg.push_back(r.true_pose.theta_rad * kDegPerRad - 90.0);
+    centre_travel_m.push_back(std::hypot(r.true_pose.x_m, r.true_pose.y_m));
+  }
+  const Stats heading = StatsOf(heading_error_deg);
+  const Stats slip = StatsOf(centre_travel_m);
+  std::cout << "turn 90 deg over " << kSeeds << " seeds: heading error mean " << heading.mean
+            << " deg, std " << heading.stddev << " deg; centre slip mean " << slip.mean
+            << " m, std " << slip.stddev << " m\n";
+  EXPECT_GE(heading.stddev, 1.0);
+  EXPECT_LE(heading.stddev, 3.0);
+  EXPECT_LT(std::abs(heading.mean), 5.0);
+  EXPECT_GE(slip.mean, 0.07);
+  EXPECT_LE(slip.mean, 0.13);
+}
+
+}  // namespace
+}  // namespace slamo::platform
