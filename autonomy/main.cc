@@ -14,10 +14,13 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  slamo field list                          the shipped seasons\n"
       "  slamo field check toss_up                 validate a season and summarise it\n"
-      "  slamo field show toss_up --out f.png      draw the field from above");
+      "  slamo field show toss_up --out f.png      draw the field from above\n"
+      "  slamo sim render --seed 1 --out DIR       an RGB-D frame of the simulated field\n"
+      "  slamo sim drive --script \"forward 0.3; turn 90\"   encoder drift against the truth");
 
   slamo::autonomy::CommandAction action;
   slamo::autonomy::RegisterFieldCommand(app, &action);
+  slamo::autonomy::RegisterSimCommand(app, &action);
 
   try {
     app.parse(argc, argv);

@@ -14,4 +14,7 @@ using CommandAction = std::function<int()>;
 // `slamo field list|check|show`.
 void RegisterFieldCommand(CLI::App& app, CommandAction* action);
 
+// `slamo sim render|drive`.
+void RegisterSimCommand(CLI::App& app, CommandAction* action);
+
 }  // namespace slamo::autonomy

@@ -1,0 +1,625 @@
+#include "platform/sim_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace slamo::platform {
+
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+enum class PrimitiveKind { kSphere, kBox, kCylinder, kRing, kPlate };
+
+struct SimRenderer::Primitive {
+  PrimitiveKind kind = PrimitiveKind::kSphere;
+  Vector3d center =
+      Vector3d::Zero();               // sphere centre; box/cylinder/ring/plate: (x, y) and unused z
+  double radius = 0.0;                // sphere, cylinder, ring outer, plate disc radius
+  double inner_radius = 0.0;          // ring
+  double half_x = 0.0, half_y = 0.0;  // box (local axes), plate half width
+  double z0 = 0.0, z1 = 0.0;          // vertical extent (box, cylinder, ring, plate)
+  double cos_yaw = 1.0, sin_yaw = 0.0;
+  Vector3d plate_normal = Vector3d::UnitX();  // plate: horizontal normal facing the viewer
+  bool plate_disc = true;
+  Vector3d albedo = Vector3d::Constant(0.5);  // RGB in [0, 1]
+  double opacity = 1.0;
+  bool glossy = false;
+  int id = 0;
+  Vector3d aabb_min, aabb_max;
+};
+
+namespace {
+
+using Primitive = SimRenderer::Primitive;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+Vector3d Albedo(const field::SeasonConfig& season, const std::string& colour) {
+  const field::Rgb& c = season.colours.at(colour);
+  return Vector3d(c.r, c.g, c.b) / 255.0;
+}
+
+double Luminance(const Vector3d& rgb) {
+  return 0.299 * rgb.x() + 0.587 * rgb.y() + 0.114 * rgb.z();
+}
+
+void SetAabb(Primitive* p) {
+  switch (p->kind) {
+    case PrimitiveKind::kSphere:
+      p->aabb_min = p->center - Vector3d::Constant(p->radius);
+      p->aabb_max = p->center + Vector3d::Constant(p->radius);
+      return;
+    case PrimitiveKind::kBox: {
+      const double ex = std::abs(p->cos_yaw) * p->half_x + std::abs(p->sin_yaw) * p->half_y;
+      const double ey = std::abs(p->sin_yaw) * p->half_x + std::abs(p->cos_yaw) * p->half_y;
+      p->aabb_min = Vector3d(p->center.x() - ex, p->center.y() - ey, p->z0);
+      p->aabb_max = Vector3d(p->center.x() + ex, p->center.y() + ey, p->z1);
+      return;
+    }
+    case PrimitiveKind::kCylinder:
+    case PrimitiveKind::kRing:
+      p->aabb_min = Vector3d(p->center.x() - p->radius, p->center.y() - p->radius, p->z0);
+      p->aabb_max = Vector3d(p->center.x() + p->radius, p->center.y() + p->radius, p->z1);
+      return;
+    case PrimitiveKind::kPlate: {
+      const double e = std::max(p->radius, p->half_x) + 0.01;
+      p->aabb_min = Vector3d(p->center.x() - e, p->center.y() - e, p->z0);
+      p->aabb_max = Vector3d(p->center.x() + e, p->center.y() + e, p->z1);
+      return;
+    }
+  }
+}
+
+// Ray o + t d against a vertical cylinder side (radius r, axis through c) within [z0, z1].
+// `inside` selects the far (inner-surface) hit.
+bool HitCylinderSide(const Vector3d& o, const Vector3d& d, const Vector3d& c, double r, double z0,
+                     double z1, bool inside, double* t, Vector3d* n) {
+  const double ox = o.x() - c.x(), oy = o.y() - c.y();
+  const double a = d.x() * d.x() + d.y() * d.y();
+  if (a < 1e-12) return false;
+  const double b = 2.0 * (ox * d.x() + oy * d.y());
+  const double cc = ox * ox + oy * oy - r * r;
+  const double disc = b * b - 4.0 * a * cc;
+  if (disc < 0.0) return false;
+  const double sq = std::sqrt(disc);
+  const double candidates[2] = {(-b - sq) / (2.0 * a), (-b + sq) / (2.0 * a)};
+  for (int k = inside ? 1 : 0; k < 2; ++k) {
+    const double tk = candidates[k];
+    if (tk <= 1e-6) continue;
+    const double z = o.z() + tk * d.z();
+    if (z < z0 || z > z1) continue;
+    *t = tk;
+    const Vector3d hit = o + tk * d;
+    *n = Vector3d(hit.x() - c.x(), hit.y() - c.y(), 0.0).normalized();
+    if (inside) *n = -*n;
+    return true;
+  }
+  return false;
+}
+
+// Nearest intersection of a ray with a primitive.
+bool Intersect(const Primitive& p, const Vector3d& o, const Vector3d& d, double* t, Vector3d* n) {
+  switch (p.kind) {
+    case PrimitiveKind::kSphere: {
+      const Vector3d oc = o - p.center;
+      const double b = oc.dot(d);
+      const double c = oc.squaredNorm() - p.radius * p.radius;
+      const double a = d.squaredNorm();
+      const double disc = b * b - a * c;
+      if (disc < 0.0) return false;
+      const double tt = (-b - std::sqrt(disc)) / a;
+      if (tt <= 1e-6) return false;
+      *t = tt;
+      *n = (o + tt * d - p.center) / p.radius;
+      return true;
+    }
+    case PrimitiveKind::kBox: {
+      // Into the box's local frame (yaw about z).
+      const double rx = o.x() - p.center.x(), ry = o.y() - p.center.y();
+      const Vector3d lo(p.cos_yaw * rx + p.sin_yaw * ry, -p.sin_yaw * rx + p.cos_yaw * ry, o.z());
+      const Vector3d ld(p.cos_yaw * d.x() + p.sin_yaw * d.y(),
+                        -p.sin_yaw * d.x() + p.cos_yaw * d.y(), d.z());
+      const double lo_b[3] = {-p.half_x, -p.half_y, p.z0};
+      const double hi_b[3] = {p.half_x, p.half_y, p.z1};
+      double t_near = -std::numeric_limits<double>::infinity();
+      double t_far = std::numeric_limits<double>::infinity();
+      int axis = -1;
+      double sign = 1.0;
+      for (int i = 0; i < 3; ++i) {
+        if (std::abs(ld[i]) < 1e-12) {
+          if (lo[i] < lo_b[i] || lo[i] > hi_b[i]) return false;
+          continue;
+        }
+        double t0 = (lo_b[i] - lo[i]) / ld[i];
+        double t1 = (hi_b[i] - lo[i]) / ld[i];
+        double s = -1.0;
+        if (t0 > t1) std::swap(t0, t1), s = 1.0;
+        if (t0 > t_near) t_near = t0, axis = i, sign = s;
+        t_far = std::min(t_far, t1);
+        if (t_near > t_far) return false;
+      }
+      if (t_near <= 1e-6 || axis < 0) return false;
+      *t = t_near;
+      Vector3d ln = Vector3d::Zero();
+      ln[axis] = sign;
+      *n = Vector3d(p.cos_yaw * ln.x() - p.sin_yaw * ln.y(),
+                    p.sin_yaw * ln.x() + p.cos_yaw * ln.y(), ln.z());
+      return true;
+    }
+    case PrimitiveKind::kCylinder:
+    case PrimitiveKind::kRing: {
+      double best = std::numeric_limits<double>::infinity();
+      Vector3d best_n = Vector3d::Zero();
+      double tt = 0.0;
+      Vector3d nn = Vector3d::Zero();
+      if (HitCylinderSide(o, d, p.center, p.radius, p.z0, p.z1, false, &tt, &nn) && tt < best)
+        best = tt, best_n = nn;
+      if (p.kind == PrimitiveKind::kRing &&
+          HitCylinderSide(o, d, p.center, p.inner_radius, p.z0, p.z1, true, &tt, &nn) &&
+          tt < best) {
+        best = tt, best_n = nn;
+      }
+      // Caps.
+      if (std::abs(d.z()) > 1e-12) {
+        for (const double zc : {p.z1, p.z0}) {
+          tt = (zc - o.z()) / d.z();
+          if (tt <= 1e-6 || tt >= best) continue;
+          const double dx = o.x() + tt * d.x() - p.center.x();
+          const double dy = o.y() + tt * d.y() - p.center.y();
+          const double r2 = dx * dx + dy * dy;
+          if (r2 > p.radius * p.radius) continue;
+          if (p.kind == PrimitiveKind::kRing && r2 < p.inner_radius * p.inner_radius) continue;
+          best = tt, best_n = Vector3d(0, 0, zc == p.z1 ? 1.0 : -1.0);
+        }
+      }
+      if (!std::isfinite(best)) return false;
+      *t = best;
+      *n = best_n;
+      return true;
+    }
+    case PrimitiveKind::kPlate: {
+      const double denom = p.plate_normal.dot(d);
+      if (std::abs(denom) < 1e-9) return false;
+      const double tt = p.plate_normal.dot(p.center - o) / denom;
+      if (tt <= 1e-6) return false;
+      const Vector3d hit = o + tt * d;
+      const Vector3d rel = hit - p.center;
+      if (p.plate_disc) {
+        if (rel.squaredNorm() > p.radius * p.radius) return false;
+      } else {
+        const Vector3d side = Vector3d::UnitZ().cross(p.plate_normal);
+        if (std::abs(rel.dot(side)) > p.half_x || std::abs(rel.z()) > p.half_x) return false;
+      }
+      *t = tt;
+      *n = denom < 0 ? p.plate_normal : -p.plate_normal;
+      return true;
+    }
+  }
+  return false;
+}
+
+Primitive ObjectPrimitive(const field::SeasonConfig& season, const SimObject& object) {
+  const field::ObjectType& type = *object.type;
+  Primitive p;
+  p.id = object.id;
+  p.albedo = Albedo(season, object.colour);
+  p.opacity = type.material == field::Material::kSemiTransparent ? type.opacity : 1.0;
+  p.center = object.center_m;
+  const double half_h = type.height_m / 2.0;
+  p.z0 = object.center_m.z() - half_h;
+  p.z1 = object.center_m.z() + half_h;
+  switch (type.shape) {
+    case field::ObjectShape::kSphere:
+    case field::ObjectShape::kTriball:  // rendered as its bounding sphere
+      p.kind = PrimitiveKind::kSphere;
+      p.radius = type.size_m / 2.0;
+      p.glossy = true;
+      break;
+    case field::ObjectShape::kCube:
+    case field::ObjectShape::kHollowBlock:
+      p.kind = PrimitiveKind::kBox;
+      p.half_x = p.half_y = type.size_m / 2.0;
+      break;
+    case field::ObjectShape::kTorus:  // a flat ring: outer diameter size_m, tube = height
+      p.kind = PrimitiveKind::kRing;
+      p.radius = type.size_m / 2.0;
+      p.inner_radius = std::max(0.0, p.radius - std::max(type.height_m, type.size_m * 0.2));
+      break;
+    case field::ObjectShape::kStar:  // a low prism: a cylinder of 80 % of the star's span
+      p.kind = PrimitiveKind::kCylinder;
+      p.radius = 0.4 * type.size_m;
+      break;
+    case field::ObjectShape::kCylinder:
+      p.kind = PrimitiveKind::kCylinder;
+      p.radius = type.size_m / 2.0;
+      break;
+  }
+  SetAabb(&p);
+  return p;
+}
+
+}  // namespace
+
+struct SimRenderer::Buffers {
+  int width = 0, height = 0;
+  std::vector<float> t;          // depth along the optical axis (m), inf = nothing
+  std::vector<Vector3f> colour;  // linear RGB in [0, 1]
+  std::vector<uint16_t> id;
+  std::vector<uint8_t> no_depth;  // 1: the camera reads nothing here (black, specular, sky)
+
+  void Reset(int w, int h) {
+    width = w, height = h;
+    const size_t n = static_cast<size_t>(w) * h;
+    t.assign(n, kInf);
+    colour.assign(n, Vector3f::Zero());
+    id.assign(n, 0);
+    no_depth.assign(n, 0);
+  }
+};
+
+SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraConfig& camera,
+                         RenderOptions options, uint64_t seed)
+    : season_(season), camera_(camera), options_(options), rng_(seed) {
+  rays_cam_.reserve(static_cast<size_t>(camera.width_px) * camera.height_px);
+  for (int v = 0; v < camera.height_px; ++v) {
+    for (int u = 0; u < camera.width_px; ++u) {
+      rays_cam_.emplace_back(static_cast<float>((u + 0.5 - camera.cx) / camera.fx),
+                             static_cast<float>((v + 0.5 - camera.cy) / camera.fy), 1.0f);
+    }
+  }
+  // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
+  // without a normal draw per pixel per frame. 2^20 draws is ~5 frames' worth of pixels.
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  normal_pool_.resize(1 << 20);
+  for (float& x : normal_pool_) x = normal(rng_);
+  BuildStaticPrimitives();
+}
+
+SimRenderer::~SimRenderer() = default;
+
+void SimRenderer::BuildStaticPrimitives() {
+  for (const field::Structure& s : season_.structures) {
+    Primitive p;
+    p.center = Vector3d(s.center_m.x, s.center_m.y, 0.0);
+    p.z0 = s.z_min_m;
+    p.z1 = s.height_m;
+    p.albedo = Albedo(season_, s.colour);
+    if (s.shape == field::SolidShape::kBox) {
+      p.kind = PrimitiveKind::kBox;
+      p.half_x = s.size_m.x / 2.0;
+      p.half_y = s.size_m.y / 2.0;
+      p.cos_yaw = std::cos(s.yaw_deg * kPi / 180.0);
+      p.sin_yaw = std::sin(s.yaw_deg * kPi / 180.0);
+    } else {
+      p.kind = PrimitiveKind::kCylinder;
+      p.radius = s.radius_m;
+    }
+    SetAabb(&p);
+    static_primitives_.push_back(p);
+  }
+  // Landmarks: discs and squares are plates on the inner face of the nearest wall, facing the
+  // field; cylinders and spheres stand where they are.
+  const double half = season_.HalfSize();
+  for (size_t i = 0; i < season_.landmarks.size(); ++i) {
+    const field::Landmark& l = season_.landmarks[i];
+    Primitive p;
+    p.id = kLandmarkIdBase + static_cast<int>(i);
+    p.albedo = Albedo(season_, l.colour);
+    const double r = l.size_m / 2.0;
+    p.z0 = l.height_m - r;
+    p.z1 = l.height_m + r;
+    if (l.shape == field::LandmarkShape::kDisc || l.shape == field::LandmarkShape::kSquare) {
+      p.kind = PrimitiveKind::kPlate;
+      p.plate_disc = l.shape == field::LandmarkShape::kDisc;
+      p.radius = r;
+      p.half_x = r;
+      const bool on_x_wall = std::abs(l.position_m.x) >= std::abs(l.position_m.y);
+      double x = l.position_m.x, y = l.position_m.y;
+      const double inset = half - 0.005;
+      if (on_x_wall) {
+        x = std::clamp(x, -inset, inset);
+        p.plate_normal = Vector3d(x > 0 ? -1.0 : 1.0, 0.0, 0.0);
+      } else {
+        y = std::clamp(y, -inset, inset);
+        p.plate_normal = Vector3d(0.0, y > 0 ? -1.0 : 1.0, 0.0);
+      }
+      p.center = Vector3d(x, y, l.height_m);
+    } else if (l.shape == field::LandmarkShape::kCylinder) {
+      p.kind = PrimitiveKind::kCylinder;
+      p.radius = r;
+      p.center = Vector3d(l.position_m.x, l.position_m.y, l.height_m);
+    } else {
+      p.kind = PrimitiveKind::kSphere;
+      p.radius = r;
+      p.center = Vector3d(l.position_m.x, l.position_m.y, l.height_m);
+    }
+    SetAabb(&p);
+    static_primitives_.push_back(p);
+  }
+}
+
+Eigen::Isometry3d SimRenderer::CameraPose(const Pose2D& robot) const {
+  const double c = std::cos(robot.theta_rad);
+  const double s = std::sin(robot.theta_rad);
+  const field::CameraMount& m = camera_.mount;
+  Eigen::Matrix3d
+      base;  // columns: the camera's x (right), y (down), z (forward) in the robot frame
+  base << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  const Eigen::Matrix3d rotation =
+      (Eigen::AngleAxisd(robot.theta_rad + m.yaw_deg * kPi / 180.0, Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(m.pitch_deg * kPi / 180.0, Vector3d::UnitY()))
+          .toRotationMatrix() *
+      base;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation;
+  pose.translation() =
+      Vector3d(robot.x_m + c * m.x_m - s * m.y_m, robot.y_m + s * m.x_m + c * m.y_m, m.height_m);
+  return pose;
+}
+
+double SimRenderer::DepthSigmaM(double depth_m) const {
+  const std::vector<double>& d = camera_.noise.distance_m;
+  const std::vector<double>& s = camera_.noise.sigma_m;
+  if (depth_m <= d.front()) return s.front();
+  if (depth_m >= d.back()) return s.back();
+  const size_t i = std::upper_bound(d.begin(), d.end(), depth_m) - d.begin();
+  const double f = (depth_m - d[i - 1]) / (d[i] - d[i - 1]);
+  return s[i - 1] + f * (s[i] - s[i - 1]);
+}
+
+void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& world_from_camera,
+                             Buffers* out) const {
+  const int w = camera_.width_px;
+  const int h = camera_.height_px;
+  out->Reset(w, h);
+  const Eigen::Matrix3f rotation = world_from_camera.linear().cast<float>();
+  const Vector3d origin = world_from_camera.translation();
+  const Lighting& light = world.lighting;
+  const double half = season_.HalfSize();
+  const double wall_h = season_.field.wall_height_m;
+  const Vector3d tile_albedo = Albedo(season_, season_.field.tile_colour);
+  const Vector3d wall_albedo = Albedo(season_, season_.field.wall_colour);
+  const double tile = season_.field.tile_m;
+
+  const auto shade = [&](const Vector3d& albedo, const Vector3d& n) {
+    const double lambert = light.ambient + light.diffuse * std::max(0.0, n.dot(light.to_light));
+    return Vector3f(static_cast<float>(albedo.x() * lambert * light.tint.x()),
+                    static_cast<float>(albedo.y() * lambert * light.tint.y()),
+                    static_cast<float>(albedo.z() * lambert * light.tint.z()));
+  };
+
+  // 1. Floor, walls and the venue beyond them, for every pixel.
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      const Vector3d d = (rotation * rays_cam_[i]).cast<double>();
+      double t_wall = std::numeric_limits<double>::infinity();
+      Vector3d n_wall = Vector3d::Zero();
+      if (d.x() > 1e-9)
+        t_wall = std::min(t_wall, (half - origin.x()) / d.x()), n_wall = -Vector3d::UnitX();
+      if (d.x() < -1e-9) {
+        const double t = (-half - origin.x()) / d.x();
+        if (t < t_wall) t_wall = t, n_wall = Vector3d::UnitX();
+      }
+      if (d.y() > 1e-9) {
+        const double t = (half - origin.y()) / d.y();
+        if (t < t_wall) t_wall = t, n_wall = -Vector3d::UnitY();
+      }
+      if (d.y() < -1e-9) {
+        const double t = (-half - origin.y()) / d.y();
+        if (t < t_wall) t_wall = t, n_wall = Vector3d::UnitY();
+      }
+      const double t_floor =
+          d.z() < -1e-9 ? -origin.z() / d.z() : std::numeric_limits<double>::infinity();
+      if (t_floor < t_wall) {
+        const Vector3d p = origin + t_floor * d;
+        // Tiles: seams 4 mm wide, each tile's shade varied a little.
+        const double fx = (p.x() + half) / tile, fy = (p.y() + half) / tile;
+        const double sx = (fx - std::floor(fx)) * tile, sy = (fy - std::floor(fy)) * tile;
+        const bool seam = sx < 0.004 || sy < 0.004 || sx > tile - 0.004 || sy > tile - 0.004;
+        const int tile_hash = (static_cast<int>(std::floor(fx)) * 73856093) ^
+                              (static_cast<int>(std::floor(fy)) * 19349663);
+        const double variation = 0.96 + 0.08 * ((tile_hash & 0xff) / 255.0);
+        out->colour[i] = shade(tile_albedo * (seam ? 0.7 : variation), Vector3d::UnitZ());
+        out->t[i] = static_cast<float>(t_floor);
+      } else if (std::isfinite(t_wall) && origin.z() + t_wall * d.z() <= wall_h) {
+        out->colour[i] = shade(wall_albedo, n_wall);
+        out->t[i] = static_cast<float>(t_wall);
+      } else {
+        // The venue: dim, no depth within the camera's range.
+        const float g = static_cast<float>(0.25 + 0.1 * std::max(0.0, d.normalized().z()));
+        out->colour[i] = Vector3f(g, g, g * 1.1f);
+        out->no_depth[i] = 1;
+      }
+      if (Luminance(tile_albedo) < options_.black_albedo && std::isfinite(out->t[i]))
+        out->no_depth[i] = 1;
+    }
+  }
+
+  // 2. Solid primitives, each over its projected bounding box only.
+  std::vector<Primitive> primitives = static_primitives_;
+  std::vector<Primitive> transparent;
+  for (const SimObject& object : world.objects) {
+    if (object.held) continue;
+    Primitive p = ObjectPrimitive(season_, object);
+    (p.opacity < 1.0 ? transparent : primitives).push_back(p);
+  }
+  const Eigen::Isometry3d camera_from_world = world_from_camera.inverse();
+  const auto screen_box = [&](const Primitive& p) {
+    double u0 = w, v0 = h, u1 = -1, v1 = -1;
+    for (int k = 0; k < 8; ++k) {
+      const Vector3d corner((k & 1) ? p.aabb_max.x() : p.aabb_min.x(),
+                            (k & 2) ? p.aabb_max.y() : p.aabb_min.y(),
+                            (k & 4) ? p.aabb_max.z() : p.aabb_min.z());
+      const Vector3d c = camera_from_world * corner;
+      if (c.z() < 0.02) return cv::Rect(0, 0, w, h);  // straddles the camera plane
+      const double u = camera_.fx * c.x() / c.z() + camera_.cx;
+      const double v = camera_.fy * c.y() / c.z() + camera_.cy;
+      u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+    }
+    const int iu0 = std::max(0, static_cast<int>(std::floor(u0)));
+    const int iv0 = std::max(0, static_cast<int>(std::floor(v0)));
+    const int iu1 = std::min(w - 1, static_cast<int>(std::ceil(u1)));
+    const int iv1 = std::min(h - 1, static_cast<int>(std::ceil(v1)));
+    if (iu1 < iu0 || iv1 < iv0) return cv::Rect();
+    return cv::Rect(iu0, iv0, iu1 - iu0 + 1, iv1 - iv0 + 1);
+  };
+  const Vector3d to_light_half = light.to_light;
+  for (const Primitive& p : primitives) {
+    const cv::Rect box = screen_box(p);
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        const size_t i = static_cast<size_t>(v) * w + u;
+        const Vector3d d = (rotation * rays_cam_[i]).cast<double>();
+        double t = 0.0;
+        Vector3d n = Vector3d::Zero();
+        if (!Intersect(p, origin, d, &t, &n) || t >= out->t[i]) continue;
+        out->t[i] = static_cast<float>(t);
+        out->id[i] = static_cast<uint16_t>(p.id);
+        Vector3f c = shade(p.albedo, n);
+        if (p.glossy) {
+          const Vector3d view = -d.normalized();
+          const Vector3d halfway = (view + to_light_half).normalized();
+          const float spec =
+              static_cast<float>(0.25 * std::pow(std::max(0.0, n.dot(halfway)), 40.0));
+          c += Vector3f::Constant(spec);
+        }
+        out->colour[i] = c;
+        out->no_depth[i] = Luminance(p.albedo) < options_.black_albedo ? 1 : 0;
+      }
+    }
+  }
+
+  // 3. Semi-transparent objects, far to near, blended over what is behind them.
+  std::sort(transparent.begin(), transparent.end(), [&](const Primitive& a, const Primitive& b) {
+    return (a.center - origin).squaredNorm() > (b.center - origin).squaredNorm();
+  });
+  for (const Primitive& p : transparent) {
+    const cv::Rect box = screen_box(p);
+    const Vector3f tint = p.albedo.cast<float>();
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        const size_t i = static_cast<size_t>(v) * w + u;
+        const Vector3d d = (rotation * rays_cam_[i]).cast<double>();
+        double t = 0.0;
+        Vector3d n = Vector3d::Zero();
+        if (!Intersect(p, origin, d, &t, &n) || t >= out->t[i]) continue;
+        const Vector3d view = -d.normalized();
+        // Thin tinted plastic: the background shows through, filtered by the tint.
+        const Vector3f behind =
+            out->colour[i].cwiseProduct(Vector3f::Constant(0.35f) + 0.65f * tint);
+        Vector3f c = static_cast<float>(p.opacity) * shade(p.albedo, n) +
+                     static_cast<float>(1.0 - p.opacity) * behind;
+        // Reflections: the ceiling lights as bright low-saturation patches, stronger at
+        // grazing angles (Fresnel), plus the light's specular highlight.
+        const Vector3d reflected = 2.0 * n.dot(view) * n - view;
+        const double fresnel = 0.1 + 0.9 * std::pow(1.0 - std::max(0.0, n.dot(view)), 4.0);
+        const double azimuth = std::atan2(reflected.y(), reflected.x());
+        const double ceiling = std::clamp((reflected.z() - 0.45) / 0.25, 0.0, 1.0) *
+                               (0.5 + 0.5 * std::sin(6.0 * azimuth + 3.0 * reflected.z()));
+        const double patch = std::min(1.0, fresnel * 0.6 + 0.7 * ceiling);
+        const Vector3d halfway = (view + light.to_light).normalized();
+        const double spec = 0.9 * std::pow(std::max(0.0, n.dot(halfway)), 60.0);
+        c = (1.0f - static_cast<float>(patch)) * c +
+            static_cast<float>(patch) * Vector3f::Constant(0.85f);
+        c += Vector3f::Constant(static_cast<float>(spec));
+        out->colour[i] = c;
+        out->t[i] = static_cast<float>(t);
+        out->id[i] = static_cast<uint16_t>(p.id);
+        out->no_depth[i] = spec > options_.specular_dropout ? 1 : 0;
+      }
+    }
+  }
+}
+
+RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double t_s,
+                              FrameTruth* truth) {
+  const int w = camera_.width_px;
+  const int h = camera_.height_px;
+  const Eigen::Isometry3d world_from_camera = CameraPose(robot);
+  Buffers depth_pass;
+  RenderPass(world, world_from_camera, &depth_pass);
+  Buffers colour_pass_storage;
+  const Buffers* colour_pass = &depth_pass;
+  if (options_.colour_depth_baseline && camera_.colour_depth_baseline_m != 0.0) {
+    Eigen::Isometry3d colour_pose = world_from_camera;
+    colour_pose.translation() +=
+        world_from_camera.linear() * Vector3d(camera_.colour_depth_baseline_m, 0, 0);
+    RenderPass(world, colour_pose, &colour_pass_storage);
+    colour_pass = &colour_pass_storage;
+  }
+
+  RgbdFrame frame;
+  frame.t_s = t_s;
+  frame.index = frame_index_++;
+  frame.colour.create(h, w, CV_8UC3);
+  frame.depth_mm.create(h, w, CV_16UC1);
+  const size_t pool = normal_pool_.size();
+  std::uniform_int_distribution<size_t> offset(0, pool - 1);
+  size_t k_colour = offset(rng_);
+  size_t k_depth = offset(rng_);
+  const float colour_sigma =
+      options_.colour_noise ? static_cast<float>(options_.colour_noise_sigma) : 0.0f;
+  const double a = options_.depth_bias ? camera_.depth_correction.a : 1.0;
+  const double b_mm = options_.depth_bias ? camera_.depth_correction.b_mm : 0.0;
+  for (int v = 0; v < h; ++v) {
+    cv::Vec3b* colour_row = frame.colour.ptr<cv::Vec3b>(v);
+    uint16_t* depth_row = frame.depth_mm.ptr<uint16_t>(v);
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      const Vector3f& c = colour_pass->colour[i];
+      for (int ch = 0; ch < 3; ++ch) {
+        float value = c[2 - ch] * 255.0f;  // RGB -> BGR
+        if (colour_sigma > 0.0f) value += colour_sigma * normal_pool_[k_colour++ & (pool - 1)];
+        colour_row[u][ch] = cv::saturate_cast<uint8_t>(value);
+      }
+      const double z = depth_pass.t[i];
+      uint16_t depth = 0;
+      if (!depth_pass.no_depth[i] && std::isfinite(z) && z >= camera_.min_range_m &&
+          z <= camera_.max_range_m) {
+        double measured_mm = a * z * 1000.0 + b_mm;
+        if (options_.depth_noise)
+          measured_mm += 1000.0 * DepthSigmaM(z) * normal_pool_[k_depth++ & (pool - 1)];
+        depth = cv::saturate_cast<uint16_t>(std::lround(measured_mm));
+      }
+      depth_row[u] = depth;
+    }
+  }
+
+  if (truth) {
+    truth->robot = robot;
+    truth->world_from_camera = world_from_camera;
+    truth->objects.clear();
+    truth->landmarks.clear();
+    truth->ids = cv::Mat(h, w, CV_16UC1, const_cast<uint16_t*>(depth_pass.id.data())).clone();
+    // Pixel counts and boxes per id.
+    std::vector<int> count(kLandmarkIdBase + season_.landmarks.size(), 0);
+    std::vector<cv::Rect> boxes(count.size());
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const uint16_t id = depth_pass.id[static_cast<size_t>(v) * w + u];
+        if (id == 0 || id >= count.size()) continue;
+        boxes[id] = count[id]++ ? (boxes[id] | cv::Rect(u, v, 1, 1)) : cv::Rect(u, v, 1, 1);
+      }
+    }
+    const Eigen::Isometry3d camera_from_world = world_from_camera.inverse();
+    for (const SimObject& object : world.objects) {
+      if (object.id >= static_cast<int>(count.size()) || count[object.id] == 0) continue;
+      truth->objects.push_back({object.id, object.type->name, object.colour, object.center_m,
+                                camera_from_world * object.center_m, count[object.id],
+                                boxes[object.id]});
+    }
+    for (size_t l = 0; l < season_.landmarks.size(); ++l) {
+      const int id = kLandmarkIdBase + static_cast<int>(l);
+      if (count[id] == 0) continue;
+      const field::Landmark& landmark = season_.landmarks[l];
+      const Vector3d position(landmark.position_m.x, landmark.position_m.y, landmark.height_m);
+      truth->landmarks.push_back(
+          {static_cast<int>(l), position, camera_from_world * position, count[id], boxes[id]});
+    }
+  }
+  return frame;
+}
+
+}  // namespace slamo::platform

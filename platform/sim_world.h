@@ -1,0 +1,56 @@
+// The simulated field's state: the season's fixed elements plus the objects (placed from the
+// config, random regions drawn from the seed), opponent robots on their scripted paths, and
+// the lighting of this run. Owned by the simulator; the renderer and physics read it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "field_configs/season_config.h"
+#include "platform/drive_base.h"
+
+namespace slamo::platform {
+
+struct SimObject {
+  int id = 0;  // 1-based, stable for the run
+  const field::ObjectType* type = nullptr;
+  std::string colour;
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  // centre of the object's bounding box
+  bool held = false;    // in a robot's intake: not on the field, not rendered
+  bool scored = false;  // released in a goal
+};
+
+struct SimOpponent {
+  field::OpponentRobot config;
+  Pose2D pose;
+  size_t next_waypoint = 1;
+};
+
+// Scene lighting, varied by the seed: a directional light plus ambient, with a colour tint.
+struct Lighting {
+  Eigen::Vector3d to_light = Eigen::Vector3d(0.3, 0.2, 0.93).normalized();
+  double ambient = 0.45;
+  double diffuse = 0.6;
+  Eigen::Vector3d tint = Eigen::Vector3d::Ones();  // per channel, RGB
+};
+
+struct SimWorld {
+  const field::SeasonConfig* season = nullptr;
+  std::vector<SimObject> objects;
+  std::vector<SimOpponent> opponents;
+  Lighting lighting;
+};
+
+// Places every object of the season (region placements drawn uniformly from `seed`, kept off
+// other objects and blocking structures) and picks the lighting from `seed`.
+SimWorld CreateWorld(const field::SeasonConfig& season, uint64_t seed);
+
+// True when a rectangle footprint at `pose` (length along the heading) is inside the
+// perimeter and clear of every structure that blocks robots.
+bool FootprintIsFree(const field::SeasonConfig& season, const Pose2D& pose, double length_m,
+                     double width_m);
+
+}  // namespace slamo::platform
