@@ -247,6 +247,7 @@ struct SimRenderer::Buffers {
   std::vector<Vector3f> colour;  // linear RGB in [0, 1]
   std::vector<uint16_t> id;
   std::vector<uint8_t> no_depth;  // 1: the camera reads nothing here (black, specular, sky)
+  std::vector<Vector3d> rays_world;  // per pixel, the ray direction in the world (camera z = 1)
 
   void Reset(int w, int h) {
     width = w, height = h;
@@ -274,6 +275,11 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
   normal_pool_.resize(1 << 20);
   for (float& x : normal_pool_) x = normal(rng_);
   BuildStaticPrimitives();
+  // sigma(d) per millimetre of depth, so the per-pixel noise needs no table search.
+  sigma_mm_by_mm_.resize(static_cast<size_t>(camera.max_range_m * 1000.0) + 2);
+  for (size_t mm = 0; mm < sigma_mm_by_mm_.size(); ++mm) {
+    sigma_mm_by_mm_[mm] = static_cast<float>(1000.0 * DepthSigmaM((mm + 0.5) / 1000.0));
+  }
 }
 
 SimRenderer::~SimRenderer() = default;
@@ -389,11 +395,15 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
                     static_cast<float>(albedo.z() * lambert * light.tint.z()));
   };
 
-  // 1. Floor, walls and the venue beyond them, for every pixel.
+  // 1. Floor, walls and the venue beyond them, for every pixel; the world rays are kept for
+  // the passes below.
+  std::vector<Vector3d>& rays = out->rays_world;
+  rays.resize(rays_cam_.size());
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
       const Vector3d d = (rotation * rays_cam_[i]).cast<double>();
+      rays[i] = d;
       double t_wall = std::numeric_limits<double>::infinity();
       Vector3d n_wall = Vector3d::Zero();
       if (d.x() > 1e-9)
@@ -448,6 +458,14 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   const Eigen::Isometry3d camera_from_world = world_from_camera.inverse();
   const auto screen_box = [&](const Primitive& p) {
     double u0 = w, v0 = h, u1 = -1, v1 = -1;
+    int behind = 0;
+    for (int k = 0; k < 8; ++k) {
+      const Vector3d corner((k & 1) ? p.aabb_max.x() : p.aabb_min.x(),
+                            (k & 2) ? p.aabb_max.y() : p.aabb_min.y(),
+                            (k & 4) ? p.aabb_max.z() : p.aabb_min.z());
+      behind += (camera_from_world * corner).z() < 0.02;
+    }
+    if (behind == 8) return cv::Rect();  // wholly behind the camera
     for (int k = 0; k < 8; ++k) {
       const Vector3d corner((k & 1) ? p.aabb_max.x() : p.aabb_min.x(),
                             (k & 2) ? p.aabb_max.y() : p.aabb_min.y(),
@@ -471,7 +489,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     for (int v = box.y; v < box.y + box.height; ++v) {
       for (int u = box.x; u < box.x + box.width; ++u) {
         const size_t i = static_cast<size_t>(v) * w + u;
-        const Vector3d d = (rotation * rays_cam_[i]).cast<double>();
+        const Vector3d& d = rays[i];
         double t = 0.0;
         Vector3d n = Vector3d::Zero();
         if (!Intersect(p, origin, d, &t, &n) || t >= out->t[i]) continue;
@@ -501,7 +519,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     for (int v = box.y; v < box.y + box.height; ++v) {
       for (int u = box.x; u < box.x + box.width; ++u) {
         const size_t i = static_cast<size_t>(v) * w + u;
-        const Vector3d d = (rotation * rays_cam_[i]).cast<double>();
+        const Vector3d& d = rays[i];
         double t = 0.0;
         Vector3d n = Vector3d::Zero();
         if (!Intersect(p, origin, d, &t, &n) || t >= out->t[i]) continue;
@@ -579,8 +597,10 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
       if (!depth_pass.no_depth[i] && std::isfinite(z) && z >= camera_.min_range_m &&
           z <= camera_.max_range_m) {
         double measured_mm = a * z * 1000.0 + b_mm;
-        if (options_.depth_noise)
-          measured_mm += 1000.0 * DepthSigmaM(z) * normal_pool_[k_depth++ & (pool - 1)];
+        if (options_.depth_noise) {
+          const size_t mm = std::min(sigma_mm_by_mm_.size() - 1, static_cast<size_t>(z * 1000.0));
+          measured_mm += sigma_mm_by_mm_[mm] * normal_pool_[k_depth++ & (pool - 1)];
+        }
         depth = cv::saturate_cast<uint16_t>(std::lround(measured_mm));
       }
       depth_row[u] = depth;
