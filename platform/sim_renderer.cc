@@ -246,7 +246,7 @@ struct SimRenderer::Buffers {
   std::vector<float> t;          // depth along the optical axis (m), inf = nothing
   std::vector<Vector3f> colour;  // linear RGB in [0, 1]
   std::vector<uint16_t> id;
-  std::vector<uint8_t> no_depth;  // 1: the camera reads nothing here (black, specular, sky)
+  std::vector<uint8_t> no_depth;     // 1: the camera reads nothing here (black, specular, sky)
   std::vector<Vector3d> rays_world;  // per pixel, the ray direction in the world (camera z = 1)
 
   void Reset(int w, int h) {
