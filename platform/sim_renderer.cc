@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <limits>
+
+#include <opencv2/imgproc.hpp>
 
 namespace slamo::platform {
 
@@ -38,6 +41,17 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 Vector3d Albedo(const field::SeasonConfig& season, const std::string& colour) {
   const field::Rgb& c = season.colours.at(colour);
   return Vector3d(c.r, c.g, c.b) / 255.0;
+}
+
+// x^n by squaring (n >= 0): the highlight exponents, without std::pow per pixel.
+double PowInt(double x, int n) {
+  double result = 1.0;
+  while (n > 0) {
+    if (n & 1) result *= x;
+    x *= x;
+    n >>= 1;
+  }
+  return result;
 }
 
 double Luminance(const Vector3d& rgb) {
@@ -247,21 +261,28 @@ struct SimRenderer::Buffers {
   std::vector<Vector3f> colour;  // linear RGB in [0, 1]
   std::vector<uint16_t> id;
   std::vector<uint8_t> no_depth;     // 1: the camera reads nothing here (black, specular, sky)
-  std::vector<Vector3d> rays_world;  // per pixel, the ray direction in the world (camera z = 1)
+  std::vector<Vector3f> rays_world;  // per pixel, the ray direction in the world (camera z = 1)
 
   void Reset(int w, int h) {
     width = w, height = h;
     const size_t n = static_cast<size_t>(w) * h;
-    t.assign(n, kInf);
-    colour.assign(n, Vector3f::Zero());
-    id.assign(n, 0);
-    no_depth.assign(n, 0);
+    // Kept between frames: resizing is a no-op after the first, so no fresh pages per frame.
+    t.resize(n), colour.resize(n), id.resize(n), no_depth.resize(n), rays_world.resize(n);
+    std::fill(t.begin(), t.end(), kInf);
+    std::fill(colour.begin(), colour.end(), Vector3f::Zero());
+    std::fill(id.begin(), id.end(), uint16_t{0});
+    std::fill(no_depth.begin(), no_depth.end(), uint8_t{0});
   }
 };
 
 SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraConfig& camera,
                          RenderOptions options, uint64_t seed)
-    : season_(season), camera_(camera), options_(options), rng_(seed) {
+    : season_(season),
+      camera_(camera),
+      options_(options),
+      rng_(seed),
+      depth_buffers_(std::make_unique<Buffers>()),
+      colour_buffers_(std::make_unique<Buffers>()) {
   rays_cam_.reserve(static_cast<size_t>(camera.width_px) * camera.height_px);
   for (int v = 0; v < camera.height_px; ++v) {
     for (int u = 0; u < camera.width_px; ++u) {
@@ -396,54 +417,61 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   };
 
   // 1. Floor, walls and the venue beyond them, for every pixel; the world rays are kept for
-  // the passes below.
-  std::vector<Vector3d>& rays = out->rays_world;
-  rays.resize(rays_cam_.size());
+  // the passes below. Single precision and per-frame constants: this loop touches every pixel.
+  std::vector<Vector3f>& rays = out->rays_world;
+  const Vector3f o = origin.cast<float>();
+  const float half_f = static_cast<float>(half);
+  const float tile_f = static_cast<float>(tile);
+  const float wall_h_f = static_cast<float>(wall_h);
+  const Vector3f floor_colour = shade(tile_albedo, Vector3d::UnitZ());
+  const Vector3f wall_colour[4] = {
+      shade(wall_albedo, -Vector3d::UnitX()), shade(wall_albedo, Vector3d::UnitX()),
+      shade(wall_albedo, -Vector3d::UnitY()), shade(wall_albedo, Vector3d::UnitY())};
+  const bool floor_black = Luminance(tile_albedo) < options_.black_albedo;
+  const bool wall_black = Luminance(wall_albedo) < options_.black_albedo;
+  constexpr float kSeamM = 0.004f;
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
-      const Vector3d d = (rotation * rays_cam_[i]).cast<double>();
+      const Vector3f d = rotation * rays_cam_[i];
       rays[i] = d;
-      double t_wall = std::numeric_limits<double>::infinity();
-      Vector3d n_wall = Vector3d::Zero();
-      if (d.x() > 1e-9)
-        t_wall = std::min(t_wall, (half - origin.x()) / d.x()), n_wall = -Vector3d::UnitX();
-      if (d.x() < -1e-9) {
-        const double t = (-half - origin.x()) / d.x();
-        if (t < t_wall) t_wall = t, n_wall = Vector3d::UnitX();
+      // Nearest perimeter wall along the ray (the camera is inside the field).
+      float t_wall = kInf;
+      int wall = 0;
+      if (d.x() > 1e-9f) t_wall = (half_f - o.x()) / d.x(), wall = 0;
+      if (d.x() < -1e-9f) t_wall = (-half_f - o.x()) / d.x(), wall = 1;
+      if (d.y() > 1e-9f) {
+        const float t = (half_f - o.y()) / d.y();
+        if (t < t_wall) t_wall = t, wall = 2;
       }
-      if (d.y() > 1e-9) {
-        const double t = (half - origin.y()) / d.y();
-        if (t < t_wall) t_wall = t, n_wall = -Vector3d::UnitY();
+      if (d.y() < -1e-9f) {
+        const float t = (-half_f - o.y()) / d.y();
+        if (t < t_wall) t_wall = t, wall = 3;
       }
-      if (d.y() < -1e-9) {
-        const double t = (-half - origin.y()) / d.y();
-        if (t < t_wall) t_wall = t, n_wall = Vector3d::UnitY();
-      }
-      const double t_floor =
-          d.z() < -1e-9 ? -origin.z() / d.z() : std::numeric_limits<double>::infinity();
+      const float t_floor = d.z() < -1e-9f ? -o.z() / d.z() : kInf;
       if (t_floor < t_wall) {
-        const Vector3d p = origin + t_floor * d;
         // Tiles: seams 4 mm wide, each tile's shade varied a little.
-        const double fx = (p.x() + half) / tile, fy = (p.y() + half) / tile;
-        const double sx = (fx - std::floor(fx)) * tile, sy = (fy - std::floor(fy)) * tile;
-        const bool seam = sx < 0.004 || sy < 0.004 || sx > tile - 0.004 || sy > tile - 0.004;
-        const int tile_hash = (static_cast<int>(std::floor(fx)) * 73856093) ^
-                              (static_cast<int>(std::floor(fy)) * 19349663);
-        const double variation = 0.96 + 0.08 * ((tile_hash & 0xff) / 255.0);
-        out->colour[i] = shade(tile_albedo * (seam ? 0.7 : variation), Vector3d::UnitZ());
-        out->t[i] = static_cast<float>(t_floor);
-      } else if (std::isfinite(t_wall) && origin.z() + t_wall * d.z() <= wall_h) {
-        out->colour[i] = shade(wall_albedo, n_wall);
-        out->t[i] = static_cast<float>(t_wall);
+        const float fx = (o.x() + t_floor * d.x() + half_f) / tile_f;
+        const float fy = (o.y() + t_floor * d.y() + half_f) / tile_f;
+        const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);  // fx, fy >= 0 inside
+        const float sx = (fx - ix) * tile_f, sy = (fy - iy) * tile_f;
+        const bool seam =
+            sx < kSeamM || sy < kSeamM || sx > tile_f - kSeamM || sy > tile_f - kSeamM;
+        const int tile_hash = (ix * 73856093) ^ (iy * 19349663);
+        const float variation = 0.96f + 0.08f * ((tile_hash & 0xff) / 255.0f);
+        out->colour[i] = floor_colour * (seam ? 0.7f : variation);
+        out->t[i] = t_floor;
+        out->no_depth[i] = floor_black;
+      } else if (t_wall < kInf && o.z() + t_wall * d.z() <= wall_h_f) {
+        out->colour[i] = wall_colour[wall];
+        out->t[i] = t_wall;
+        out->no_depth[i] = wall_black;
       } else {
         // The venue: dim, no depth within the camera's range.
-        const float g = static_cast<float>(0.25 + 0.1 * std::max(0.0, d.normalized().z()));
+        const float g = 0.25f + 0.1f * std::max(0.0f, d.z() / d.norm());
         out->colour[i] = Vector3f(g, g, g * 1.1f);
         out->no_depth[i] = 1;
       }
-      if (Luminance(tile_albedo) < options_.black_albedo && std::isfinite(out->t[i]))
-        out->no_depth[i] = 1;
     }
   }
 
@@ -456,57 +484,66 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     (p.opacity < 1.0 ? transparent : primitives).push_back(p);
   }
   const Eigen::Isometry3d camera_from_world = world_from_camera.inverse();
+  // A primitive's pixels lie inside the projection of its bounding box. The box's corners are
+  // taken into the camera frame and their camera-space bounds clipped at the near plane, so a
+  // box that straddles the camera plane still gets a tight screen box.
   const auto screen_box = [&](const Primitive& p) {
-    double u0 = w, v0 = h, u1 = -1, v1 = -1;
-    int behind = 0;
-    for (int k = 0; k < 8; ++k) {
-      const Vector3d corner((k & 1) ? p.aabb_max.x() : p.aabb_min.x(),
-                            (k & 2) ? p.aabb_max.y() : p.aabb_min.y(),
-                            (k & 4) ? p.aabb_max.z() : p.aabb_min.z());
-      behind += (camera_from_world * corner).z() < 0.02;
-    }
-    if (behind == 8) return cv::Rect();  // wholly behind the camera
+    constexpr double kNear = 0.02;
+    Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Vector3d hi = -lo;
     for (int k = 0; k < 8; ++k) {
       const Vector3d corner((k & 1) ? p.aabb_max.x() : p.aabb_min.x(),
                             (k & 2) ? p.aabb_max.y() : p.aabb_min.y(),
                             (k & 4) ? p.aabb_max.z() : p.aabb_min.z());
       const Vector3d c = camera_from_world * corner;
-      if (c.z() < 0.02) return cv::Rect(0, 0, w, h);  // straddles the camera plane
-      const double u = camera_.fx * c.x() / c.z() + camera_.cx;
-      const double v = camera_.fy * c.y() / c.z() + camera_.cy;
-      u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+      lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
     }
-    const int iu0 = std::max(0, static_cast<int>(std::floor(u0)));
-    const int iv0 = std::max(0, static_cast<int>(std::floor(v0)));
-    const int iu1 = std::min(w - 1, static_cast<int>(std::ceil(u1)));
-    const int iv1 = std::min(h - 1, static_cast<int>(std::ceil(v1)));
+    if (hi.z() < kNear) return cv::Rect();  // wholly behind the camera
+    const double z_near = std::max(lo.z(), kNear);
+    // x / z over the clipped box is extreme at its corners.
+    const auto range = [&](double a, double b, double f, double centre, double* out_lo,
+                           double* out_hi) {
+      const double values[4] = {a / z_near, a / hi.z(), b / z_near, b / hi.z()};
+      *out_lo = f * *std::min_element(values, values + 4) + centre;
+      *out_hi = f * *std::max_element(values, values + 4) + centre;
+    };
+    double u0, u1, v0, v1;
+    range(lo.x(), hi.x(), camera_.fx, camera_.cx, &u0, &u1);
+    range(lo.y(), hi.y(), camera_.fy, camera_.cy, &v0, &v1);
+    const int iu0 = static_cast<int>(std::max(0.0, std::floor(u0)));
+    const int iv0 = static_cast<int>(std::max(0.0, std::floor(v0)));
+    const int iu1 = static_cast<int>(std::min(w - 1.0, std::ceil(u1)));
+    const int iv1 = static_cast<int>(std::min(h - 1.0, std::ceil(v1)));
     if (iu1 < iu0 || iv1 < iv0) return cv::Rect();
     return cv::Rect(iu0, iv0, iu1 - iu0 + 1, iv1 - iv0 + 1);
   };
-  const Vector3d to_light_half = light.to_light;
-  for (const Primitive& p : primitives) {
+  // Calls on_hit(pixel, ray, t, normal) for each pixel where `p` is the nearest surface so far.
+  const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) {
     const cv::Rect box = screen_box(p);
     for (int v = box.y; v < box.y + box.height; ++v) {
       for (int u = box.x; u < box.x + box.width; ++u) {
         const size_t i = static_cast<size_t>(v) * w + u;
-        const Vector3d& d = rays[i];
+        const Vector3d d = rays[i].cast<double>();
         double t = 0.0;
         Vector3d n = Vector3d::Zero();
-        if (!Intersect(p, origin, d, &t, &n) || t >= out->t[i]) continue;
-        out->t[i] = static_cast<float>(t);
-        out->id[i] = static_cast<uint16_t>(p.id);
-        Vector3f c = shade(p.albedo, n);
-        if (p.glossy) {
-          const Vector3d view = -d.normalized();
-          const Vector3d halfway = (view + to_light_half).normalized();
-          const float spec =
-              static_cast<float>(0.25 * std::pow(std::max(0.0, n.dot(halfway)), 40.0));
-          c += Vector3f::Constant(spec);
-        }
-        out->colour[i] = c;
-        out->no_depth[i] = Luminance(p.albedo) < options_.black_albedo ? 1 : 0;
+        if (Intersect(p, origin, d, &t, &n) && t < out->t[i]) on_hit(i, d, t, n);
       }
     }
+  };
+  for (const Primitive& p : primitives) {
+    for_each_hit(p, [&](size_t i, const Vector3d& d, double t, const Vector3d& n) {
+      out->t[i] = static_cast<float>(t);
+      out->id[i] = static_cast<uint16_t>(p.id);
+      Vector3f c = shade(p.albedo, n);
+      if (p.glossy) {
+        const Vector3d view = -d.normalized();
+        const Vector3d halfway = (view + light.to_light).normalized();
+        const float spec = static_cast<float>(0.25 * PowInt(std::max(0.0, n.dot(halfway)), 40));
+        c += Vector3f::Constant(spec);
+      }
+      out->colour[i] = c;
+      out->no_depth[i] = Luminance(p.albedo) < options_.black_albedo ? 1 : 0;
+    });
   }
 
   // 3. Semi-transparent objects, far to near, blended over what is behind them.
@@ -514,40 +551,37 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     return (a.center - origin).squaredNorm() > (b.center - origin).squaredNorm();
   });
   for (const Primitive& p : transparent) {
-    const cv::Rect box = screen_box(p);
     const Vector3f tint = p.albedo.cast<float>();
-    for (int v = box.y; v < box.y + box.height; ++v) {
-      for (int u = box.x; u < box.x + box.width; ++u) {
-        const size_t i = static_cast<size_t>(v) * w + u;
-        const Vector3d& d = rays[i];
-        double t = 0.0;
-        Vector3d n = Vector3d::Zero();
-        if (!Intersect(p, origin, d, &t, &n) || t >= out->t[i]) continue;
-        const Vector3d view = -d.normalized();
-        // Thin tinted plastic: the background shows through, filtered by the tint.
-        const Vector3f behind =
-            out->colour[i].cwiseProduct(Vector3f::Constant(0.35f) + 0.65f * tint);
-        Vector3f c = static_cast<float>(p.opacity) * shade(p.albedo, n) +
-                     static_cast<float>(1.0 - p.opacity) * behind;
-        // Reflections: the ceiling lights as bright low-saturation patches, stronger at
-        // grazing angles (Fresnel), plus the light's specular highlight.
-        const Vector3d reflected = 2.0 * n.dot(view) * n - view;
-        const double fresnel = 0.1 + 0.9 * std::pow(1.0 - std::max(0.0, n.dot(view)), 4.0);
-        const double azimuth = std::atan2(reflected.y(), reflected.x());
-        const double ceiling = std::clamp((reflected.z() - 0.45) / 0.25, 0.0, 1.0) *
-                               (0.5 + 0.5 * std::sin(6.0 * azimuth + 3.0 * reflected.z()));
-        const double patch = std::min(1.0, fresnel * 0.6 + 0.7 * ceiling);
-        const Vector3d halfway = (view + light.to_light).normalized();
-        const double spec = 0.9 * std::pow(std::max(0.0, n.dot(halfway)), 60.0);
-        c = (1.0f - static_cast<float>(patch)) * c +
-            static_cast<float>(patch) * Vector3f::Constant(0.85f);
-        c += Vector3f::Constant(static_cast<float>(spec));
-        out->colour[i] = c;
-        out->t[i] = static_cast<float>(t);
-        out->id[i] = static_cast<uint16_t>(p.id);
-        out->no_depth[i] = spec > options_.specular_dropout ? 1 : 0;
+    for_each_hit(p, [&](size_t i, const Vector3d& d, double t, const Vector3d& n) {
+      const Vector3d view = -d.normalized();
+      // Thin tinted plastic: the background shows through, filtered by the tint.
+      const Vector3f behind = out->colour[i].cwiseProduct(Vector3f::Constant(0.35f) + 0.65f * tint);
+      Vector3f c = static_cast<float>(p.opacity) * shade(p.albedo, n) +
+                   static_cast<float>(1.0 - p.opacity) * behind;
+      // Reflections: the ceiling lights as bright low-saturation patches, stronger at
+      // grazing angles (Fresnel), plus the light's specular highlight.
+      const Vector3d reflected = 2.0 * n.dot(view) * n - view;
+      const double grazing = 1.0 - std::max(0.0, n.dot(view));
+      const double fresnel = 0.1 + 0.9 * (grazing * grazing) * (grazing * grazing);
+      // Six ceiling light bands around the azimuth: sin(6 phi) from (x + iy)^6, no trig.
+      double ceiling = std::clamp((reflected.z() - 0.45) / 0.25, 0.0, 1.0);
+      if (ceiling > 0.0) {
+        const double r = std::hypot(reflected.x(), reflected.y());
+        const std::complex<double> c1(reflected.x() / r, reflected.y() / r);
+        const std::complex<double> c2 = c1 * c1;
+        ceiling *= 0.5 + 0.5 * (c2 * c2 * c2).imag();
       }
-    }
+      const double patch = std::min(1.0, fresnel * 0.6 + 0.7 * ceiling);
+      const Vector3d halfway = (view + light.to_light).normalized();
+      const double spec = 0.9 * PowInt(std::max(0.0, n.dot(halfway)), 60);
+      c = (1.0f - static_cast<float>(patch)) * c +
+          static_cast<float>(patch) * Vector3f::Constant(0.85f);
+      c += Vector3f::Constant(static_cast<float>(spec));
+      out->colour[i] = c;
+      out->t[i] = static_cast<float>(t);
+      out->id[i] = static_cast<uint16_t>(p.id);
+      out->no_depth[i] = spec > options_.specular_dropout ? 1 : 0;
+    });
   }
 }
 
@@ -556,9 +590,9 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
   const int w = camera_.width_px;
   const int h = camera_.height_px;
   const Eigen::Isometry3d world_from_camera = CameraPose(robot);
-  Buffers depth_pass;
+  Buffers& depth_pass = *depth_buffers_;
   RenderPass(world, world_from_camera, &depth_pass);
-  Buffers colour_pass_storage;
+  Buffers& colour_pass_storage = *colour_buffers_;
   const Buffers* colour_pass = &depth_pass;
   if (options_.colour_depth_baseline && camera_.colour_depth_baseline_m != 0.0) {
     Eigen::Isometry3d colour_pose = world_from_camera;
@@ -573,38 +607,44 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
   frame.index = frame_index_++;
   frame.colour.create(h, w, CV_8UC3);
   frame.depth_mm.create(h, w, CV_16UC1);
-  const size_t pool = normal_pool_.size();
-  std::uniform_int_distribution<size_t> offset(0, pool - 1);
-  size_t k_colour = offset(rng_);
-  size_t k_depth = offset(rng_);
-  const float colour_sigma =
-      options_.colour_noise ? static_cast<float>(options_.colour_noise_sigma) : 0.0f;
-  const double a = options_.depth_bias ? camera_.depth_correction.a : 1.0;
-  const double b_mm = options_.depth_bias ? camera_.depth_correction.b_mm : 0.0;
-  for (int v = 0; v < h; ++v) {
-    cv::Vec3b* colour_row = frame.colour.ptr<cv::Vec3b>(v);
-    uint16_t* depth_row = frame.depth_mm.ptr<uint16_t>(v);
-    for (int u = 0; u < w; ++u) {
-      const size_t i = static_cast<size_t>(v) * w + u;
-      const Vector3f& c = colour_pass->colour[i];
-      for (int ch = 0; ch < 3; ++ch) {
-        float value = c[2 - ch] * 255.0f;  // RGB -> BGR
-        if (colour_sigma > 0.0f) value += colour_sigma * normal_pool_[k_colour++ & (pool - 1)];
-        colour_row[u][ch] = cv::saturate_cast<uint8_t>(value);
+  // Noise comes from the pool, from a random offset each frame (contiguous: SIMD-friendly).
+  const size_t n = static_cast<size_t>(w) * h;
+  std::uniform_int_distribution<size_t> offset(0, normal_pool_.size() - 3 * n);
+  const float* colour_noise = normal_pool_.data() + offset(rng_);
+  const float* depth_noise = normal_pool_.data() + offset(rng_);
+
+  // Colour: 255 * linear RGB + sigma * N(0, 1), to 8-bit BGR, with OpenCV's vector code.
+  const cv::Mat colour_f(h, w, CV_32FC3, const_cast<Vector3f*>(colour_pass->colour.data()));
+  cv::Mat scaled;
+  if (options_.colour_noise) {
+    const cv::Mat noise(h, w, CV_32FC3, const_cast<float*>(colour_noise));
+    cv::scaleAdd(noise, options_.colour_noise_sigma / 255.0, colour_f, scaled);
+  } else {
+    scaled = colour_f;
+  }
+  cv::Mat rgb8;
+  scaled.convertTo(rgb8, CV_8UC3, 255.0);
+  cv::cvtColor(rgb8, frame.colour, cv::COLOR_RGB2BGR);
+
+  // Depth: the camera's linear error, then sigma(d) noise, in whole millimetres.
+  const float a = static_cast<float>(options_.depth_bias ? camera_.depth_correction.a : 1.0);
+  const float b_mm = static_cast<float>(options_.depth_bias ? camera_.depth_correction.b_mm : 0.0);
+  const float min_range = static_cast<float>(camera_.min_range_m);
+  const float max_range = static_cast<float>(camera_.max_range_m);
+  const size_t sigma_last = sigma_mm_by_mm_.size() - 1;
+  uint16_t* depth_out = frame.depth_mm.ptr<uint16_t>(0);
+  for (size_t i = 0; i < n; ++i) {
+    const float z = depth_pass.t[i];
+    uint16_t depth = 0;
+    if (!depth_pass.no_depth[i] && z >= min_range && z <= max_range) {  // false for inf
+      float measured_mm = a * z * 1000.0f + b_mm;
+      if (options_.depth_noise) {
+        measured_mm += sigma_mm_by_mm_[std::min(sigma_last, static_cast<size_t>(z * 1000.0f))] *
+                       depth_noise[i];
       }
-      const double z = depth_pass.t[i];
-      uint16_t depth = 0;
-      if (!depth_pass.no_depth[i] && std::isfinite(z) && z >= camera_.min_range_m &&
-          z <= camera_.max_range_m) {
-        double measured_mm = a * z * 1000.0 + b_mm;
-        if (options_.depth_noise) {
-          const size_t mm = std::min(sigma_mm_by_mm_.size() - 1, static_cast<size_t>(z * 1000.0));
-          measured_mm += sigma_mm_by_mm_[mm] * normal_pool_[k_depth++ & (pool - 1)];
-        }
-        depth = cv::saturate_cast<uint16_t>(std::lround(measured_mm));
-      }
-      depth_row[u] = depth;
+      depth = static_cast<uint16_t>(std::clamp(measured_mm + 0.5f, 0.0f, 65535.0f));
     }
+    depth_out[i] = depth;
   }
 
   if (truth) {

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -93,7 +94,9 @@ class SimRenderer {
   std::vector<Eigen::Vector3f> rays_cam_;  // per pixel, z = 1
   std::vector<float> normal_pool_;         // N(0, 1) draws, read from a random offset per frame
   std::vector<Primitive> static_primitives_;
-  std::vector<float> sigma_mm_by_mm_;  // sigma(d) in mm, indexed by depth in whole mm
+  std::vector<float> sigma_mm_by_mm_;        // sigma(d) in mm, indexed by depth in whole mm
+  std::unique_ptr<Buffers> depth_buffers_;   // reused every frame
+  std::unique_ptr<Buffers> colour_buffers_;  // with the colour-depth baseline only
   int64_t frame_index_ = 0;
 };
 
