@@ -4,16 +4,16 @@
 
 namespace slamo::field {
 
+bool ScoresFor(const SeasonConfig& season, const std::string& colour, Alliance alliance) {
+  if (!season.rules.own_colour_only) return true;
+  if (colour == "red") return alliance == Alliance::kRed;
+  if (colour == "blue") return alliance == Alliance::kBlue;
+  return true;
+}
+
 int BestPoints(const SeasonConfig& season, const std::string& type, const std::string& colour,
                Alliance alliance) {
-  // With own-colour scoring, a red object only scores for red (and blue for blue); objects of
-  // other colours (neutral) score for either alliance.
-  if (season.rules.own_colour_only) {
-    if ((colour == "red" && alliance != Alliance::kRed) ||
-        (colour == "blue" && alliance != Alliance::kBlue)) {
-      return 0;
-    }
-  }
+  if (!ScoresFor(season, colour, alliance)) return 0;
   int best = 0;
   for (const Goal& goal : season.goals) {
     if (goal.alliance != Alliance::kNone && goal.alliance != alliance) continue;

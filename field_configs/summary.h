@@ -21,6 +21,10 @@ struct SeasonSummary {
 
 SeasonSummary Summarise(const SeasonConfig& season);
 
+// Whether an object of `colour` can score for `alliance` at all: with own-colour scoring a red
+// object scores only for red and a blue one only for blue; other colours score for either.
+bool ScoresFor(const SeasonConfig& season, const std::string& colour, Alliance alliance);
+
 // The most points one object of `type` and `colour` can earn for `alliance`; 0 if none.
 int BestPoints(const SeasonConfig& season, const std::string& type, const std::string& colour,
                Alliance alliance);

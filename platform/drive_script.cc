@@ -74,10 +74,12 @@ DriveStep ParseStatement(int index, const std::string& statement) {
 // The controller: runs in lockstep with the simulator and sees only its encoders.
 class Runner {
  public:
-  Runner(const DriveControllerOptions& options, SimDriveBase* sim, SimClock* clock)
+  Runner(const DriveControllerOptions& options, SimDriveBase* sim, SimClock* clock,
+         std::function<void(double)> advance)
       : options_(options),
         sim_(sim),
         clock_(clock),
+        advance_(advance ? std::move(advance) : [sim](double dt_s) { sim->Step(dt_s); }),
         half_track_m_(0.5 * sim->drive().track_width_m),
         odometry_(sim->metres_per_tick(), sim->drive().track_width_m, sim->ReadEncoders(),
                   sim->odometry_pose()),
@@ -122,7 +124,7 @@ class Runner {
 
   // One controller period: simulator and clock advance together, then the encoders are read.
   void Tick() {
-    sim_->Step(options_.control_dt_s);
+    advance_(options_.control_dt_s);
     clock_->Advance(options_.control_dt_s);
     const double before_rad = odometry_.pose().theta_rad;
     odometry_.Update(sim_->ReadEncoders());
@@ -207,6 +209,7 @@ class Runner {
   DriveControllerOptions options_;
   SimDriveBase* sim_;
   SimClock* clock_;
+  std::function<void(double)> advance_;  // steps the simulator (and whatever it lives in)
   double half_track_m_;
   EncoderOdometry odometry_;
   double heading_rad_;           // odometry heading, unwrapped
@@ -245,8 +248,9 @@ DriveControllerOptions DriveControllerOptionsFor(const field::DriveConfig& drive
 
 std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
                                             const DriveControllerOptions& options,
-                                            SimDriveBase* sim, SimClock* clock) {
-  Runner runner(options, sim, clock);
+                                            SimDriveBase* sim, SimClock* clock,
+                                            std::function<void(double)> advance) {
+  Runner runner(options, sim, clock, std::move(advance));
   std::vector<DriveStepResult> results;
   results.reserve(steps.size());
   for (const DriveStep& step : steps) results.push_back(runner.Run(step));

@@ -67,9 +67,12 @@ struct DriveStepResult {
 
 // Drives `steps` on `sim`, advancing `clock` in lockstep with it. Headings are tracked
 // against the intended heading, so a turn also corrects the previous turn's encoder error.
+// `advance` steps the simulation (default: sim->Step); a SimField passes its own Step so
+// objects and opponents move with the robot.
 std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
                                             const DriveControllerOptions& options,
-                                            SimDriveBase* sim, SimClock* clock);
+                                            SimDriveBase* sim, SimClock* clock,
+                                            std::function<void(double)> advance = nullptr);
 
 // For the command line: parses `script` (throws DriveScriptError), builds the robot's
 // simulated drive base with `sim_options` and `seed` at `start` (collisions through the

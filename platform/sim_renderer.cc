@@ -478,6 +478,24 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   // 2. Solid primitives, each over its projected bounding box only.
   std::vector<Primitive> primitives = static_primitives_;
   std::vector<Primitive> transparent;
+  for (size_t k = 0; k < world.opponents.size(); ++k) {
+    const SimOpponent& o = world.opponents[k];
+    Primitive p;
+    p.kind = PrimitiveKind::kBox;
+    p.id = kOpponentIdBase + static_cast<int>(k);
+    p.center = Vector3d(o.pose.x_m, o.pose.y_m, 0.0);
+    p.half_x = o.config.size_m.x / 2.0;
+    p.half_y = o.config.size_m.y / 2.0;
+    p.z0 = 0.0;
+    p.z1 = o.height_m;
+    p.cos_yaw = std::cos(o.pose.theta_rad);
+    p.sin_yaw = std::sin(o.pose.theta_rad);
+    const char* alliance = field::ToString(o.config.alliance);
+    p.albedo = season_.colours.count(alliance) ? Vector3d(0.6 * Albedo(season_, alliance))
+                                               : Vector3d(Vector3d::Constant(0.3));
+    SetAabb(&p);
+    primitives.push_back(p);
+  }
   for (const SimObject& object : world.objects) {
     if (object.held) continue;
     Primitive p = ObjectPrimitive(season_, object);

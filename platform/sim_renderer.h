@@ -36,8 +36,10 @@ struct RenderOptions {
   double specular_dropout = 0.55;      // highlight strength above which no depth (reflective)
 };
 
-// Ids in FrameTruth::ids: 0 background / field, objects 1..N, landmarks kLandmarkIdBase + i.
+// Ids in FrameTruth::ids: 0 background / field, objects 1..N, landmarks kLandmarkIdBase + i,
+// opponent robots kOpponentIdBase + i.
 inline constexpr int kLandmarkIdBase = 10000;
+inline constexpr int kOpponentIdBase = 20000;
 
 struct ObjectTruth {
   int id = 0;

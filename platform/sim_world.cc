@@ -98,6 +98,23 @@ SimWorld CreateWorld(const SeasonConfig& season, uint64_t seed) {
   return world;
 }
 
+bool PointInBlockingStructure(const SeasonConfig& season, const Eigen::Vector2d& p,
+                              double clearance_m) {
+  for (const Structure& s : season.structures) {
+    if (s.blocks_robot && DistanceToStructure(s, p) <= clearance_m) return true;
+  }
+  return false;
+}
+
+bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d d = p - Eigen::Vector2d(goal.center_m.x, goal.center_m.y);
+  if (goal.shape == SolidShape::kCylinder) return d.norm() <= goal.radius_m;
+  const double yaw = goal.yaw_deg * kPi / 180.0;
+  const double lx = std::cos(yaw) * d.x() + std::sin(yaw) * d.y();
+  const double ly = -std::sin(yaw) * d.x() + std::cos(yaw) * d.y();
+  return std::abs(lx) <= goal.size_m.x / 2.0 && std::abs(ly) <= goal.size_m.y / 2.0;
+}
+
 bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double length_m,
                      double width_m) {
   const double c = std::cos(pose.theta_rad);

@@ -19,12 +19,13 @@ struct SimObject {
   const field::ObjectType* type = nullptr;
   std::string colour;
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  // centre of the object's bounding box
-  bool held = false;    // in a robot's intake: not on the field, not rendered
-  bool scored = false;  // released in a goal
+  bool held = false;  // in a robot's intake: not on the field, not rendered
+  int in_goal = -1;   // index into SeasonConfig::goals when released into a goal structure
 };
 
 struct SimOpponent {
   field::OpponentRobot config;
+  double height_m = 0.45;  // a box this tall when rendered
   Pose2D pose;
   size_t next_waypoint = 1;
 };
@@ -52,5 +53,12 @@ SimWorld CreateWorld(const field::SeasonConfig& season, uint64_t seed);
 // perimeter and clear of every structure that blocks robots.
 bool FootprintIsFree(const field::SeasonConfig& season, const Pose2D& pose, double length_m,
                      double width_m);
+
+// True when the point lies on a structure that blocks robots (and objects).
+bool PointInBlockingStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p,
+                              double clearance_m);
+
+// True when the point lies inside a goal's footprint (box with yaw, or cylinder).
+bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p);
 
 }  // namespace slamo::platform

@@ -17,6 +17,7 @@
 #include "field_configs/loader.h"
 #include "platform/drive_script.h"
 #include "platform/sim_drive.h"
+#include "platform/sim_field.h"
 #include "platform/sim_renderer.h"
 #include "platform/sim_world.h"
 
@@ -129,17 +130,20 @@ int Drive(const SimArgs& args) {
               << ": the robot does not fit there (wall or structure)\n";
     return 2;
   }
-  const auto is_free = [&season, &robot](const Pose2D& pose) {
-    return platform::FootprintIsFree(season, pose, robot.length_m, robot.width_m);
-  };
-  std::vector<platform::DriveStepResult> results;
+  std::vector<platform::DriveStep> steps;
   try {
-    results = platform::SimulateDriveScript(args.script, robot, platform::SimDriveOptions{},
-                                            args.seed, start, is_free);
+    steps = platform::ParseDriveScript(args.script);
   } catch (const platform::DriveScriptError& e) {
     std::cerr << "error: --script: " << e.what() << "\n";
     return 2;
   }
+  // The whole field: the robot pushes objects, opponents follow their paths.
+  platform::SimField field(season, robot, field::Alliance::kRed, args.seed, start);
+  const platform::SimWorld before = field.world();
+  platform::SimClock clock;
+  const std::vector<platform::DriveStepResult> results =
+      platform::RunDriveScript(steps, platform::DriveControllerOptionsFor(robot.drive),
+                               &field.drive(), &clock, [&field](double dt_s) { field.Step(dt_s); });
   std::printf("%s on %s, seed %llu, start (%.3f, %.3f, %.1f deg)\n", robot.name.c_str(),
               season.season.c_str(), static_cast<unsigned long long>(args.seed), start.x_m,
               start.y_m, start.theta_rad * 180.0 / kPi);
@@ -155,6 +159,12 @@ int Drive(const SimArgs& args) {
                 o.y_m, o.theta_rad * 180 / kPi, pos_err, th_err,
                 r.status == platform::DriveStepStatus::kTimedOut ? "  (timed out)" : "");
   }
+  int pushed = 0;
+  for (size_t i = 0; i < before.objects.size(); ++i) {
+    pushed += (field.world().objects[i].center_m - before.objects[i].center_m).norm() > 0.005;
+  }
+  std::printf("objects moved by robots: %d; score now red %d, blue %d\n", pushed,
+              field.Score(field::Alliance::kRed), field.Score(field::Alliance::kBlue));
   return 0;
 }
 

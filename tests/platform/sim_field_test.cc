@@ -1,0 +1,171 @@
+#include "platform/sim_field.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "field_configs/loader.h"
+#include "platform/drive_script.h"
+#include "platform/sim_renderer.h"
+
+namespace slamo::platform {
+namespace {
+
+using field::Alliance;
+
+// Toss Up with only the objects a test places, driven from an open spot.
+class SimFieldTest : public ::testing::Test {
+ protected:
+  SimFieldTest() : robot_(field::LoadRobotConfig("thesis_robot")) {
+    season_ = field::LoadSeasonConfig("toss_up");
+    season_.objects.clear();
+  }
+
+  void Place(const std::string& type, const std::string& colour, double x, double y) {
+    field::ObjectPlacement p;
+    p.type = type;
+    p.colour = colour;
+    p.position_m = field::Vec2{x, y};
+    season_.objects.push_back(p);
+  }
+
+  // Drives a script on the field (objects and opponents move with the robot).
+  std::vector<DriveStepResult> Drive(SimField* field, const std::string& script) {
+    SimClock clock;
+    return RunDriveScript(ParseDriveScript(script), DriveControllerOptionsFor(robot_.drive),
+                          &field->drive(), &clock, [field](double dt) { field->Step(dt); });
+  }
+
+  static double Distance(const Eigen::Vector3d& a, double x, double y) {
+    return std::hypot(a.x() - x, a.y() - y);
+  }
+
+  field::SeasonConfig season_;
+  field::RobotConfig robot_;
+};
+
+TEST_F(SimFieldTest, RobotPushesABallInItsWay) {
+  Place("buckyball", "red", -0.3, -0.6);  // on the bump line, 0.6 m ahead of the start
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-0.9, -0.6, 0.0});
+  Drive(&field, "forward 0.8");
+  const SimObject& ball = field.world().objects[0];
+  const Pose2D& robot = field.robot_pose();
+  EXPECT_GT(robot.x_m, -0.3);  // the robot drove through the ball's start...
+  // ...and the ball went ahead of it, touching the bumper, not overlapping it.
+  const double ahead = ball.center_m.x() - robot.x_m;
+  EXPECT_GE(ahead, robot_.length_m / 2.0 + 0.0635 - 0.01);
+  EXPECT_LE(ahead, robot_.length_m / 2.0 + 0.0635 + 0.03);
+  EXPECT_NEAR(ball.center_m.y(), robot.y_m, 0.08);
+}
+
+TEST_F(SimFieldTest, BallPinnedAgainstTheWallStopsTheRobot) {
+  Place("buckyball", "red", -1.2, -1.70);  // against the side wall (y = -1.829)
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-1.2, -1.1, -kPi / 2.0});
+  Drive(&field, "forward 0.6");
+  const SimObject& ball = field.world().objects[0];
+  EXPECT_GE(std::abs(ball.center_m.y()), 1.70 - 1e-9);  // never pushed into the wall
+  EXPECT_LE(std::abs(ball.center_m.y()), season_.HalfSize() - 0.0635 + 1e-9);
+  // The robot stopped with the ball between its bumper and the wall.
+  EXPECT_GT(field.robot_pose().y_m, -1.70 + robot_.length_m / 2.0);
+}
+
+TEST_F(SimFieldTest, IntakePicksOnlyWithinReachInFront) {
+  Place("buckyball", "red", -0.9 + 0.225 + 0.0635 + 0.05, -0.6);  // 5 cm ahead of the bumper
+  Place("buckyball", "blue", -0.9 - 0.5, -0.6);                   // behind the robot
+  Place("buckyball", "blue", -0.9 + 0.8, -0.6);                   // too far ahead
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-0.9, -0.6, 0.0});
+  const std::optional<int> picked = field.Pick();
+  ASSERT_TRUE(picked.has_value());
+  EXPECT_EQ(*picked, 1);
+  EXPECT_TRUE(field.world().objects[0].held);
+  EXPECT_EQ(field.HeldCount(), 1);
+  EXPECT_FALSE(field.Pick().has_value());  // capacity 1
+  ASSERT_TRUE(field.Release().has_value());
+  EXPECT_FALSE(field.Pick().has_value() && field.world().objects[1].held);  // behind: never
+}
+
+TEST_F(SimFieldTest, ReleaseInTheGoalZoneScoresByTheRules) {
+  // The robot faces the far wall from inside the goal zone (x > 0.61 in Toss Up).
+  Place("buckyball", "red", 1.0 + 0.225 + 0.0635 + 0.03, 1.5);
+  Place("buckyball", "blue", 1.0 + 0.225 + 0.0635 + 0.03, -1.5);
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{1.0, 1.5, 0.0});
+  const int before_red = field.Score(Alliance::kRed);
+  ASSERT_TRUE(field.Pick().has_value());
+  EXPECT_EQ(field.Score(Alliance::kRed), before_red - 2);  // held: it no longer counts
+  const std::optional<ReleaseResult> released = field.Release();
+  ASSERT_TRUE(released.has_value());
+  ASSERT_TRUE(released->goal_index.has_value());
+  EXPECT_EQ(season_.goals[*released->goal_index].name, "goal_zone");
+  EXPECT_EQ(released->points, 2);  // a red buckyball in the goal zone, for red
+  EXPECT_EQ(field.Score(Alliance::kRed), before_red);
+  // Own-colour rule: the blue ball in the goal zone earns red nothing, blue 2.
+  EXPECT_EQ(field.ObjectPoints(field.world().objects[1], Alliance::kRed), 0);
+  EXPECT_EQ(field.ObjectPoints(field.world().objects[1], Alliance::kBlue), 2);
+}
+
+TEST_F(SimFieldTest, ReleaseOverTheStashScoresTheGoal) {
+  // The red stash is a cylinder at (0.45, 0.61), radius 0.14: drop into it from the west.
+  Place("buckyball", "red", 0.45 - 0.14 - 0.30 + 0.05, 0.61);
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{0.45 - 0.14 - 0.30 - 0.225, 0.61, 0.0});
+  ASSERT_TRUE(field.Pick().has_value());
+  // Drive up to the stash (the ball is held, so the bumper reaches the goal).
+  Drive(&field, "forward 0.35");  // stops against the stash
+  const std::optional<ReleaseResult> released = field.Release();
+  ASSERT_TRUE(released.has_value());
+  ASSERT_TRUE(released->goal_index.has_value());
+  EXPECT_EQ(season_.goals[*released->goal_index].name, "red_stash");
+  EXPECT_EQ(released->points, 5);
+}
+
+TEST_F(SimFieldTest, OpponentFollowsItsPathAndPushesObjects) {
+  Place("buckyball", "blue", 0.0, 1.45);  // on the opponent's path
+  field::OpponentRobot opponent;
+  opponent.alliance = Alliance::kBlue;
+  opponent.size_m = field::Vec2{0.4, 0.4};
+  opponent.speed_mps = 0.5;
+  opponent.path_m = {{-0.9, 1.45}, {1.3, 1.45}, {1.3, 0.0}};  // past the barrier's end
+  season_.opponents = {opponent};
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-0.9, -1.2, 0.0});
+  for (int i = 0; i < 440; ++i) field.Step(0.01);  // 4.4 s: the 2.2 m first leg
+  const SimOpponent& o = field.world().opponents[0];
+  EXPECT_NEAR(o.pose.x_m, 1.3, 0.02);
+  EXPECT_NEAR(o.pose.y_m, 1.45, 0.02);
+  // The ball was shoved along in front of it, never left overlapping.
+  const SimObject& ball = field.world().objects[0];
+  EXPECT_GT(ball.center_m.x(), 0.5);
+  EXPECT_GE(
+      std::max(std::abs(ball.center_m.x() - o.pose.x_m), std::abs(ball.center_m.y() - o.pose.y_m)),
+      0.2 + 0.0635 - 1e-6);
+  for (int i = 0; i < 400; ++i) field.Step(0.01);
+  EXPECT_NEAR(field.world().opponents[0].pose.y_m, 0.0, 0.02);  // finished, no loop
+  EXPECT_NEAR(field.world().opponents[0].pose.x_m, 1.3, 0.02);
+}
+
+TEST_F(SimFieldTest, OpponentIsRendered) {
+  field::OpponentRobot opponent;
+  opponent.alliance = Alliance::kBlue;
+  opponent.size_m = field::Vec2{0.4, 0.4};
+  opponent.speed_mps = 0.3;
+  opponent.path_m = {{0.0, -0.6}, {0.0, 0.6}};
+  season_.opponents = {opponent};
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-1.2, -0.6, 0.0});
+  SimRenderer renderer(season_, robot_.camera, RenderOptions{}, 1);
+  FrameTruth truth;
+  renderer.Render(field.world(), field.robot_pose(), 0.0, &truth);
+  EXPECT_GT(cv::countNonZero(truth.ids == kOpponentIdBase), 1000);
+}
+
+TEST_F(SimFieldTest, RobotCannotDriveThroughAnOpponent) {
+  field::OpponentRobot opponent;
+  opponent.alliance = Alliance::kBlue;
+  opponent.size_m = field::Vec2{0.4, 0.4};
+  opponent.speed_mps = 0.1;
+  opponent.path_m = {{0.0, -0.6}, {0.0, -0.6001}};  // parked
+  season_.opponents = {opponent};
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-0.9, -0.6, 0.0});
+  Drive(&field, "forward 1.2");
+  EXPECT_LE(field.robot_pose().x_m, -0.2 - 0.225 + 0.01);
+}
+
+}  // namespace
+}  // namespace slamo::platform
