@@ -44,8 +44,8 @@ Vector3d Albedo(const field::SeasonConfig& season, const std::string& colour) {
 }
 
 // x^n by squaring (n >= 0): the highlight exponents, without std::pow per pixel.
-double PowInt(double x, int n) {
-  double result = 1.0;
+float PowInt(float x, int n) {
+  float result = 1.0f;
   while (n > 0) {
     if (n & 1) result *= x;
     x *= x;
@@ -260,18 +260,16 @@ struct SimRenderer::Buffers {
   std::vector<float> t;          // depth along the optical axis (m), inf = nothing
   std::vector<Vector3f> colour;  // linear RGB in [0, 1]
   std::vector<uint16_t> id;
-  std::vector<uint8_t> no_depth;     // 1: the camera reads nothing here (black, specular, sky)
-  std::vector<Vector3f> rays_world;  // per pixel, the ray direction in the world (camera z = 1)
+  std::vector<uint8_t> no_depth;   // 1: the camera reads nothing here (black, specular, sky)
+  std::vector<Vector3f> row_rays;  // per row, the world ray of its first pixel (camera z = 1)
 
   void Reset(int w, int h) {
     width = w, height = h;
     const size_t n = static_cast<size_t>(w) * h;
     // Kept between frames: resizing is a no-op after the first, so no fresh pages per frame.
-    t.resize(n), colour.resize(n), id.resize(n), no_depth.resize(n), rays_world.resize(n);
-    std::fill(t.begin(), t.end(), kInf);
-    std::fill(colour.begin(), colour.end(), Vector3f::Zero());
+    t.resize(n), colour.resize(n), id.resize(n), no_depth.resize(n), row_rays.resize(h);
+    // t, colour and no_depth are written for every pixel by the floor pass.
     std::fill(id.begin(), id.end(), uint16_t{0});
-    std::fill(no_depth.begin(), no_depth.end(), uint8_t{0});
   }
 };
 
@@ -284,10 +282,12 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
       depth_buffers_(std::make_unique<Buffers>()),
       colour_buffers_(std::make_unique<Buffers>()) {
   rays_cam_.reserve(static_cast<size_t>(camera.width_px) * camera.height_px);
+  ray_length2_.reserve(rays_cam_.capacity());
   for (int v = 0; v < camera.height_px; ++v) {
     for (int u = 0; u < camera.width_px; ++u) {
       rays_cam_.emplace_back(static_cast<float>((u + 0.5 - camera.cx) / camera.fx),
                              static_cast<float>((v + 0.5 - camera.cy) / camera.fy), 1.0f);
+      ray_length2_.push_back(rays_cam_.back().squaredNorm());
     }
   }
   // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
@@ -409,16 +409,22 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   const Vector3d wall_albedo = Albedo(season_, season_.field.wall_colour);
   const double tile = season_.field.tile_m;
 
-  const auto shade = [&](const Vector3d& albedo, const Vector3d& n) {
-    const double lambert = light.ambient + light.diffuse * std::max(0.0, n.dot(light.to_light));
-    return Vector3f(static_cast<float>(albedo.x() * lambert * light.tint.x()),
-                    static_cast<float>(albedo.y() * lambert * light.tint.y()),
-                    static_cast<float>(albedo.z() * lambert * light.tint.z()));
+  const Vector3f to_light_f = light.to_light.cast<float>();
+  const Vector3f tint_f = light.tint.cast<float>();
+  const float ambient_f = static_cast<float>(light.ambient);
+  const float diffuse_f = static_cast<float>(light.diffuse);
+  // Lambert: albedo * (ambient + diffuse * max(0, n . l)) * tint.
+  const auto shade_f = [&](const Vector3f& albedo, const Vector3f& n) -> Vector3f {
+    const float lambert = ambient_f + diffuse_f * std::max(0.0f, n.dot(to_light_f));
+    return albedo.cwiseProduct(tint_f) * lambert;
+  };
+  const auto shade = [&](const Vector3d& albedo, const Vector3d& n) -> Vector3f {
+    return shade_f(albedo.cast<float>(), n.cast<float>());
   };
 
   // 1. Floor, walls and the venue beyond them, for every pixel; the world rays are kept for
   // the passes below. Single precision and per-frame constants: this loop touches every pixel.
-  std::vector<Vector3f>& rays = out->rays_world;
+  std::vector<Vector3f>& row_rays = out->row_rays;
   const Vector3f o = origin.cast<float>();
   const float half_f = static_cast<float>(half);
   const float tile_f = static_cast<float>(tile);
@@ -430,12 +436,35 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   const bool floor_black = Luminance(tile_albedo) < options_.black_albedo;
   const bool wall_black = Luminance(wall_albedo) < options_.black_albedo;
   constexpr float kSeamM = 0.004f;
+  // The world ray is linear in u along a row: start of row plus u steps.
+  const Vector3f ray_step = rotation.col(0) / static_cast<float>(camera_.fx);
   for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
+    Vector3f d = rotation * rays_cam_[static_cast<size_t>(v) * w];
+    row_rays[v] = d;
+    for (int u = 0; u < w; ++u, d += ray_step) {
       const size_t i = static_cast<size_t>(v) * w + u;
-      const Vector3f d = rotation * rays_cam_[i];
-      rays[i] = d;
-      // Nearest perimeter wall along the ray (the camera is inside the field).
+      // A floor point inside the perimeter is reached before any wall (the camera is inside
+      // the field), so the walls are only tested for rays that miss the field's floor.
+      if (d.z() < -1e-9f) {
+        const float t_floor = -o.z() / d.z();
+        const float px = o.x() + t_floor * d.x() + half_f;
+        const float py = o.y() + t_floor * d.y() + half_f;
+        if (px >= 0.0f && py >= 0.0f && px <= 2.0f * half_f && py <= 2.0f * half_f) {
+          // Tiles: seams 4 mm wide, each tile's shade varied a little.
+          const float fx = px / tile_f, fy = py / tile_f;
+          const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+          const float sx = (fx - ix) * tile_f, sy = (fy - iy) * tile_f;
+          const bool seam =
+              sx < kSeamM || sy < kSeamM || sx > tile_f - kSeamM || sy > tile_f - kSeamM;
+          const int tile_hash = (ix * 73856093) ^ (iy * 19349663);
+          const float variation = 0.96f + 0.08f * ((tile_hash & 0xff) / 255.0f);
+          out->colour[i] = floor_colour * (seam ? 0.7f : variation);
+          out->t[i] = t_floor;
+          out->no_depth[i] = floor_black;
+          continue;
+        }
+      }
+      // Nearest perimeter wall along the ray.
       float t_wall = kInf;
       int wall = 0;
       if (d.x() > 1e-9f) t_wall = (half_f - o.x()) / d.x(), wall = 0;
@@ -448,21 +477,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
         const float t = (-half_f - o.y()) / d.y();
         if (t < t_wall) t_wall = t, wall = 3;
       }
-      const float t_floor = d.z() < -1e-9f ? -o.z() / d.z() : kInf;
-      if (t_floor < t_wall) {
-        // Tiles: seams 4 mm wide, each tile's shade varied a little.
-        const float fx = (o.x() + t_floor * d.x() + half_f) / tile_f;
-        const float fy = (o.y() + t_floor * d.y() + half_f) / tile_f;
-        const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);  // fx, fy >= 0 inside
-        const float sx = (fx - ix) * tile_f, sy = (fy - iy) * tile_f;
-        const bool seam =
-            sx < kSeamM || sy < kSeamM || sx > tile_f - kSeamM || sy > tile_f - kSeamM;
-        const int tile_hash = (ix * 73856093) ^ (iy * 19349663);
-        const float variation = 0.96f + 0.08f * ((tile_hash & 0xff) / 255.0f);
-        out->colour[i] = floor_colour * (seam ? 0.7f : variation);
-        out->t[i] = t_floor;
-        out->no_depth[i] = floor_black;
-      } else if (t_wall < kInf && o.z() + t_wall * d.z() <= wall_h_f) {
+      if (t_wall < kInf && o.z() + t_wall * d.z() <= wall_h_f) {
         out->colour[i] = wall_colour[wall];
         out->t[i] = t_wall;
         out->no_depth[i] = wall_black;
@@ -470,6 +485,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
         // The venue: dim, no depth within the camera's range.
         const float g = 0.25f + 0.1f * std::max(0.0f, d.z() / d.norm());
         out->colour[i] = Vector3f(g, g, g * 1.1f);
+        out->t[i] = kInf;
         out->no_depth[i] = 1;
       }
     }
@@ -538,29 +554,97 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   // Calls on_hit(pixel, ray, t, normal) for each pixel where `p` is the nearest surface so far.
   const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) {
     const cv::Rect box = screen_box(p);
+    if (p.kind == PrimitiveKind::kSphere) {
+      // Spheres, the most common object, in single precision: |d|^2 is the camera ray's
+      // (rotation keeps lengths), so a hit costs a dot product and a square root.
+      const Vector3f oc = (origin - p.center).cast<float>();
+      const float c = oc.squaredNorm() - static_cast<float>(p.radius * p.radius);
+      const float inv_r = static_cast<float>(1.0 / p.radius);
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        for (int u = box.x; u < box.x + box.width; ++u) {
+          const size_t i = static_cast<size_t>(v) * w + u;
+          const Vector3f d = row_rays[v] + static_cast<float>(u) * ray_step;
+          const float b = oc.dot(d);
+          const float a = ray_length2_[i];
+          const float disc = b * b - a * c;
+          if (disc < 0.0f) continue;
+          const float t = (-b - std::sqrt(disc)) / a;
+          if (t <= 1e-6f || t >= out->t[i]) continue;
+          on_hit(i, d, t, Vector3f((oc + t * d) * inv_r));
+        }
+      }
+      return;
+    }
+    if (p.kind == PrimitiveKind::kBox) {
+      // Boxes (structures, cubes, opponents) in single precision, in the box's own frame.
+      const float cy = static_cast<float>(p.cos_yaw), sy = static_cast<float>(p.sin_yaw);
+      const float rx = static_cast<float>(origin.x() - p.center.x());
+      const float ry = static_cast<float>(origin.y() - p.center.y());
+      const float lo_o[3] = {cy * rx + sy * ry, -sy * rx + cy * ry, static_cast<float>(origin.z())};
+      const float lo_b[3] = {static_cast<float>(-p.half_x), static_cast<float>(-p.half_y),
+                             static_cast<float>(p.z0)};
+      const float hi_b[3] = {static_cast<float>(p.half_x), static_cast<float>(p.half_y),
+                             static_cast<float>(p.z1)};
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        for (int u = box.x; u < box.x + box.width; ++u) {
+          const size_t i = static_cast<size_t>(v) * w + u;
+          const Vector3f d = row_rays[v] + static_cast<float>(u) * ray_step;
+          const float ld[3] = {cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y(), d.z()};
+          float t_near = -kInf, t_far = kInf;
+          int axis = -1;
+          float sign = 1.0f;
+          bool miss = false;
+          for (int k = 0; k < 3 && !miss; ++k) {
+            if (std::abs(ld[k]) < 1e-12f) {
+              miss = lo_o[k] < lo_b[k] || lo_o[k] > hi_b[k];
+              continue;
+            }
+            const float inv = 1.0f / ld[k];
+            float t0 = (lo_b[k] - lo_o[k]) * inv, t1 = (hi_b[k] - lo_o[k]) * inv;
+            float sg = -1.0f;
+            if (t0 > t1) std::swap(t0, t1), sg = 1.0f;
+            if (t0 > t_near) t_near = t0, axis = k, sign = sg;
+            t_far = std::min(t_far, t1);
+            miss = t_near > t_far;
+          }
+          if (miss || axis < 0 || t_near <= 1e-6f || t_near >= out->t[i]) continue;
+          Vector3f n = Vector3f::Zero();
+          if (axis == 2) {
+            n.z() = sign;
+          } else {
+            const float lx = axis == 0 ? sign : 0.0f, ly = axis == 1 ? sign : 0.0f;
+            n = Vector3f(cy * lx - sy * ly, sy * lx + cy * ly, 0.0f);
+          }
+          on_hit(i, d, t_near, n);
+        }
+      }
+      return;
+    }
     for (int v = box.y; v < box.y + box.height; ++v) {
       for (int u = box.x; u < box.x + box.width; ++u) {
         const size_t i = static_cast<size_t>(v) * w + u;
-        const Vector3d d = rays[i].cast<double>();
+        const Vector3d d = (row_rays[v] + static_cast<float>(u) * ray_step).cast<double>();
         double t = 0.0;
         Vector3d n = Vector3d::Zero();
-        if (Intersect(p, origin, d, &t, &n) && t < out->t[i]) on_hit(i, d, t, n);
+        if (Intersect(p, origin, d, &t, &n) && t < out->t[i]) {
+          on_hit(i, d.cast<float>(), static_cast<float>(t), n.cast<float>());
+        }
       }
     }
   };
   for (const Primitive& p : primitives) {
-    for_each_hit(p, [&](size_t i, const Vector3d& d, double t, const Vector3d& n) {
-      out->t[i] = static_cast<float>(t);
+    const Vector3f albedo = p.albedo.cast<float>();
+    const uint8_t black = Luminance(p.albedo) < options_.black_albedo ? 1 : 0;
+    for_each_hit(p, [&](size_t i, const Vector3f& d, float t, const Vector3f& n) {
+      out->t[i] = t;
       out->id[i] = static_cast<uint16_t>(p.id);
-      Vector3f c = shade(p.albedo, n);
+      Vector3f c = shade_f(albedo, n);
       if (p.glossy) {
-        const Vector3d view = -d.normalized();
-        const Vector3d halfway = (view + light.to_light).normalized();
-        const float spec = static_cast<float>(0.25 * PowInt(std::max(0.0, n.dot(halfway)), 40));
-        c += Vector3f::Constant(spec);
+        const Vector3f halfway = (to_light_f - d.normalized()).normalized();
+        c += Vector3f::Constant(0.25f * PowInt(std::max(0.0f, n.dot(halfway)), 40));
       }
       out->colour[i] = c;
-      out->no_depth[i] = Luminance(p.albedo) < options_.black_albedo ? 1 : 0;
+      out->no_depth[i] = black;
     });
   }
 
@@ -568,35 +652,36 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   std::sort(transparent.begin(), transparent.end(), [&](const Primitive& a, const Primitive& b) {
     return (a.center - origin).squaredNorm() > (b.center - origin).squaredNorm();
   });
+
   for (const Primitive& p : transparent) {
     const Vector3f tint = p.albedo.cast<float>();
-    for_each_hit(p, [&](size_t i, const Vector3d& d, double t, const Vector3d& n) {
-      const Vector3d view = -d.normalized();
+    const float opacity = static_cast<float>(p.opacity);
+    const Vector3f albedo = p.albedo.cast<float>();
+    for_each_hit(p, [&](size_t i, const Vector3f& d, float t, const Vector3f& n) {
+      const Vector3f view = -d.normalized();
       // Thin tinted plastic: the background shows through, filtered by the tint.
       const Vector3f behind = out->colour[i].cwiseProduct(Vector3f::Constant(0.35f) + 0.65f * tint);
-      Vector3f c = static_cast<float>(p.opacity) * shade(p.albedo, n) +
-                   static_cast<float>(1.0 - p.opacity) * behind;
+      Vector3f c = opacity * shade_f(albedo, n) + (1.0f - opacity) * behind;
       // Reflections: the ceiling lights as bright low-saturation patches, stronger at
       // grazing angles (Fresnel), plus the light's specular highlight.
-      const Vector3d reflected = 2.0 * n.dot(view) * n - view;
-      const double grazing = 1.0 - std::max(0.0, n.dot(view));
-      const double fresnel = 0.1 + 0.9 * (grazing * grazing) * (grazing * grazing);
+      const float n_dot_view = n.dot(view);
+      const Vector3f reflected = 2.0f * n_dot_view * n - view;
+      const float grazing = 1.0f - std::max(0.0f, n_dot_view);
+      const float fresnel = 0.1f + 0.9f * (grazing * grazing) * (grazing * grazing);
       // Six ceiling light bands around the azimuth: sin(6 phi) from (x + iy)^6, no trig.
-      double ceiling = std::clamp((reflected.z() - 0.45) / 0.25, 0.0, 1.0);
-      if (ceiling > 0.0) {
-        const double r = std::hypot(reflected.x(), reflected.y());
-        const std::complex<double> c1(reflected.x() / r, reflected.y() / r);
-        const std::complex<double> c2 = c1 * c1;
-        ceiling *= 0.5 + 0.5 * (c2 * c2 * c2).imag();
+      float ceiling = std::clamp((reflected.z() - 0.45f) / 0.25f, 0.0f, 1.0f);
+      if (ceiling > 0.0f) {
+        const float r2 = reflected.x() * reflected.x() + reflected.y() * reflected.y();
+        const std::complex<float> c1(reflected.x(), reflected.y());
+        const std::complex<float> c2 = c1 * c1;
+        ceiling *= 0.5f + 0.5f * (c2 * c2 * c2).imag() / (r2 * r2 * r2);
       }
-      const double patch = std::min(1.0, fresnel * 0.6 + 0.7 * ceiling);
-      const Vector3d halfway = (view + light.to_light).normalized();
-      const double spec = 0.9 * PowInt(std::max(0.0, n.dot(halfway)), 60);
-      c = (1.0f - static_cast<float>(patch)) * c +
-          static_cast<float>(patch) * Vector3f::Constant(0.85f);
-      c += Vector3f::Constant(static_cast<float>(spec));
+      const float patch = std::min(1.0f, fresnel * 0.6f + 0.7f * ceiling);
+      const float spec = 0.9f * PowInt(std::max(0.0f, n.dot((view + to_light_f).normalized())), 60);
+      c = (1.0f - patch) * c + patch * Vector3f::Constant(0.85f);
+      c += Vector3f::Constant(spec);
       out->colour[i] = c;
-      out->t[i] = static_cast<float>(t);
+      out->t[i] = t;
       out->id[i] = static_cast<uint16_t>(p.id);
       out->no_depth[i] = spec > options_.specular_dropout ? 1 : 0;
     });

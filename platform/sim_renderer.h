@@ -94,6 +94,7 @@ class SimRenderer {
   RenderOptions options_;
   std::mt19937_64 rng_;
   std::vector<Eigen::Vector3f> rays_cam_;  // per pixel, z = 1
+  std::vector<float> ray_length2_;         // per pixel, |ray|^2 (the same in every frame)
   std::vector<float> normal_pool_;         // N(0, 1) draws, read from a random offset per frame
   std::vector<Primitive> static_primitives_;
   std::vector<float> sigma_mm_by_mm_;        // sigma(d) in mm, indexed by depth in whole mm
