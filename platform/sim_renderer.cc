@@ -12,7 +12,7 @@ namespace slamo::platform {
 using Eigen::Vector3d;
 using Eigen::Vector3f;
 
-enum class PrimitiveKind { kSphere, kBox, kCylinder, kRing, kPlate };
+enum class PrimitiveKind { kSphere, kBox, kCylinder, kRing, kPlate, kPrism };
 
 struct SimRenderer::Primitive {
   PrimitiveKind kind = PrimitiveKind::kSphere;
@@ -25,6 +25,7 @@ struct SimRenderer::Primitive {
   double cos_yaw = 1.0, sin_yaw = 0.0;
   Vector3d plate_normal = Vector3d::UnitX();  // plate: horizontal normal facing the viewer
   bool plate_disc = true;
+  std::vector<Eigen::Vector2d> polygon;       // prism: outline around (x, y), counter-clockwise
   Vector3d albedo = Vector3d::Constant(0.5);  // RGB in [0, 1]
   double opacity = 1.0;
   bool glossy = false;
@@ -73,6 +74,7 @@ void SetAabb(Primitive* p) {
     }
     case PrimitiveKind::kCylinder:
     case PrimitiveKind::kRing:
+    case PrimitiveKind::kPrism:
       p->aabb_min = Vector3d(p->center.x() - p->radius, p->center.y() - p->radius, p->z0);
       p->aabb_max = Vector3d(p->center.x() + p->radius, p->center.y() + p->radius, p->z1);
       return;
@@ -192,6 +194,50 @@ bool Intersect(const Primitive& p, const Vector3d& o, const Vector3d& d, double*
       *n = best_n;
       return true;
     }
+    case PrimitiveKind::kPrism: {
+      // A vertical prism over a polygon: the caps where the hit lies inside the outline,
+      // the side walls where the ray crosses an edge between z0 and z1.
+      const Eigen::Vector2d o2(o.x() - p.center.x(), o.y() - p.center.y());
+      const Eigen::Vector2d d2(d.x(), d.y());
+      double best = std::numeric_limits<double>::infinity();
+      Vector3d best_n = Vector3d::Zero();
+      const size_t k = p.polygon.size();
+      for (size_t e = 0; e < k; ++e) {
+        const Eigen::Vector2d a = p.polygon[e];
+        const Eigen::Vector2d edge = p.polygon[(e + 1) % k] - a;
+        const double denom = d2.x() * edge.y() - d2.y() * edge.x();
+        if (std::abs(denom) < 1e-12) continue;
+        const Eigen::Vector2d ao = a - o2;
+        const double tt = (ao.x() * edge.y() - ao.y() * edge.x()) / denom;
+        const double s = (ao.x() * d2.y() - ao.y() * d2.x()) / denom;
+        if (tt <= 1e-6 || tt >= best || s < 0.0 || s > 1.0) continue;
+        const double z = o.z() + tt * d.z();
+        if (z < p.z0 || z > p.z1) continue;
+        best = tt;
+        best_n = Vector3d(edge.y(), -edge.x(), 0.0).normalized();  // outward (CCW outline)
+      }
+      if (std::abs(d.z()) > 1e-12) {
+        for (const double zc : {p.z1, p.z0}) {
+          const double tt = (zc - o.z()) / d.z();
+          if (tt <= 1e-6 || tt >= best) continue;
+          const Eigen::Vector2d q = o2 + tt * d2;
+          bool inside = false;  // crossing number
+          for (size_t e = 0, f = k - 1; e < k; f = e++) {
+            const Eigen::Vector2d& a = p.polygon[e];
+            const Eigen::Vector2d& b = p.polygon[f];
+            if ((a.y() > q.y()) != (b.y() > q.y()) &&
+                q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+              inside = !inside;
+            }
+          }
+          if (inside) best = tt, best_n = Vector3d(0, 0, zc == p.z1 ? 1.0 : -1.0);
+        }
+      }
+      if (!std::isfinite(best)) return false;
+      *t = best;
+      *n = best_n;
+      return true;
+    }
     case PrimitiveKind::kPlate: {
       const double denom = p.plate_normal.dot(d);
       if (std::abs(denom) < 1e-9) return false;
@@ -240,9 +286,14 @@ Primitive ObjectPrimitive(const field::SeasonConfig& season, const SimObject& ob
       p.radius = type.size_m / 2.0;
       p.inner_radius = std::max(0.0, p.radius - std::max(type.height_m, type.size_m * 0.2));
       break;
-    case field::ObjectShape::kStar:  // a low prism: a cylinder of 80 % of the star's span
-      p.kind = PrimitiveKind::kCylinder;
-      p.radius = 0.4 * type.size_m;
+    case field::ObjectShape::kStar:  // a five-pointed star prism, lying flat
+      p.kind = PrimitiveKind::kPrism;
+      p.radius = type.size_m / 2.0;
+      for (int k = 0; k < 10; ++k) {
+        const double angle = kPi / 2.0 + k * kPi / 5.0;
+        const double r = k % 2 == 0 ? p.radius : 0.45 * p.radius;
+        p.polygon.emplace_back(r * std::cos(angle), r * std::sin(angle));
+      }
       break;
     case field::ObjectShape::kCylinder:
       p.kind = PrimitiveKind::kCylinder;

@@ -238,3 +238,39 @@ TEST(FootprintTest, WallsAndStructuresBlock) {
 
 }  // namespace
 }  // namespace slamo::platform
+
+namespace slamo::platform {
+namespace {
+
+// Stars render as five-pointed prisms: seen from the robot they cover clearly less than the
+// cylinder around them, and far more than nothing.
+TEST(SimRendererShapesTest, StarIsAStarPrismNotADisc) {
+  field::SeasonConfig season = field::LoadSeasonConfig("starstruck");
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  season.objects.clear();
+  field::ObjectType disc = *season.FindObjectType("star");
+  disc.name = "disc";
+  disc.shape = field::ObjectShape::kCylinder;
+  season.object_types.push_back(disc);
+  const auto pixels_of = [&](const char* type) {
+    SimWorld world = CreateWorld(season, 1);
+    SimObject o;
+    o.id = 1;
+    o.type = season.FindObjectType(type);
+    o.colour = o.type->colours.front();
+    o.center_m = Eigen::Vector3d(-0.4, 0.0, o.type->height_m / 2.0);
+    world.objects = {o};
+    SimRenderer renderer(season, robot.camera, RenderOptions{}, 1);
+    FrameTruth truth;
+    renderer.Render(world, Pose2D{-1.5, 0.0, 0.0}, 0.0, &truth);
+    return truth.objects.empty() ? 0 : truth.objects[0].pixels;
+  };
+  const int star = pixels_of("star");
+  const int cylinder = pixels_of("disc");
+  EXPECT_GT(star, 200);
+  EXPECT_LT(star, 0.8 * cylinder);
+  EXPECT_GT(star, 0.3 * cylinder);
+}
+
+}  // namespace
+}  // namespace slamo::platform
