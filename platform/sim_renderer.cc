@@ -1,5 +1,7 @@
 #include "platform/sim_renderer.h"
 
+#include "platform/camera_geometry.h"
+
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -418,32 +420,11 @@ void SimRenderer::BuildStaticPrimitives() {
 }
 
 Eigen::Isometry3d SimRenderer::CameraPose(const Pose2D& robot) const {
-  const double c = std::cos(robot.theta_rad);
-  const double s = std::sin(robot.theta_rad);
-  const field::CameraMount& m = camera_.mount;
-  Eigen::Matrix3d
-      base;  // columns: the camera's x (right), y (down), z (forward) in the robot frame
-  base << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  const Eigen::Matrix3d rotation =
-      (Eigen::AngleAxisd(robot.theta_rad + m.yaw_deg * kPi / 180.0, Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(m.pitch_deg * kPi / 180.0, Vector3d::UnitY()))
-          .toRotationMatrix() *
-      base;
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = rotation;
-  pose.translation() =
-      Vector3d(robot.x_m + c * m.x_m - s * m.y_m, robot.y_m + s * m.x_m + c * m.y_m, m.height_m);
-  return pose;
+  return WorldFromRobot(robot) * RobotFromCamera(camera_.mount);
 }
 
 double SimRenderer::DepthSigmaM(double depth_m) const {
-  const std::vector<double>& d = camera_.noise.distance_m;
-  const std::vector<double>& s = camera_.noise.sigma_m;
-  if (depth_m <= d.front()) return s.front();
-  if (depth_m >= d.back()) return s.back();
-  const size_t i = std::upper_bound(d.begin(), d.end(), depth_m) - d.begin();
-  const double f = (depth_m - d[i - 1]) / (d[i] - d[i - 1]);
-  return s[i - 1] + f * (s[i] - s[i - 1]);
+  return platform::DepthSigmaM(camera_, depth_m);
 }
 
 void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& world_from_camera,
