@@ -16,11 +16,13 @@ int main(int argc, char** argv) {
       "  slamo field check toss_up                 validate a season and summarise it\n"
       "  slamo field show toss_up --out f.png      draw the field from above\n"
       "  slamo sim render --seed 1 --out DIR       an RGB-D frame of the simulated field\n"
-      "  slamo sim drive --script \"forward 0.3; turn 90\"   encoder drift against the truth");
+      "  slamo sim drive --script \"forward 0.3; turn 90\"   encoder drift against the truth\n"
+      "  slamo calibrate plane --depth DIR/depth.png   camera-to-wall distance (RANSAC plane)");
 
   slamo::autonomy::CommandAction action;
   slamo::autonomy::RegisterFieldCommand(app, &action);
   slamo::autonomy::RegisterSimCommand(app, &action);
+  slamo::autonomy::RegisterCalibrateCommand(app, &action);
 
   try {
     app.parse(argc, argv);

@@ -17,4 +17,7 @@ void RegisterFieldCommand(CLI::App& app, CommandAction* action);
 // `slamo sim render|drive`.
 void RegisterSimCommand(CLI::App& app, CommandAction* action);
 
+// `slamo calibrate plane|depth`.
+void RegisterCalibrateCommand(CLI::App& app, CommandAction* action);
+
 }  // namespace slamo::autonomy
