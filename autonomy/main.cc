@@ -17,12 +17,16 @@ int main(int argc, char** argv) {
       "  slamo field show toss_up --out f.png      draw the field from above\n"
       "  slamo sim render --seed 1 --out DIR       an RGB-D frame of the simulated field\n"
       "  slamo sim drive --script \"forward 0.3; turn 90\"   encoder drift against the truth\n"
-      "  slamo calibrate plane --depth DIR/depth.png   camera-to-wall distance (RANSAC plane)");
+      "  slamo calibrate plane --depth DIR/depth.png   camera-to-wall distance (RANSAC plane)\n"
+      "  slamo detect --color DIR/colour.png --depth DIR/depth.png --out seen.png\n"
+      "  slamo eval vision --frames 50             detection methods against ground truth");
 
   slamo::autonomy::CommandAction action;
   slamo::autonomy::RegisterFieldCommand(app, &action);
   slamo::autonomy::RegisterSimCommand(app, &action);
   slamo::autonomy::RegisterCalibrateCommand(app, &action);
+  slamo::autonomy::RegisterDetectCommand(app, &action);
+  slamo::autonomy::RegisterEvalCommand(app, &action);
 
   try {
     app.parse(argc, argv);

@@ -20,4 +20,10 @@ void RegisterSimCommand(CLI::App& app, CommandAction* action);
 // `slamo calibrate plane|depth`.
 void RegisterCalibrateCommand(CLI::App& app, CommandAction* action);
 
+// `slamo detect`.
+void RegisterDetectCommand(CLI::App& app, CommandAction* action);
+
+// `slamo eval vision`.
+void RegisterEvalCommand(CLI::App& app, CommandAction* action);
+
 }  // namespace slamo::autonomy

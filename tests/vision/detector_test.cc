@@ -1,0 +1,199 @@
+#include "vision/detector.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "field_configs/loader.h"
+#include "platform/sim_renderer.h"
+#include "platform/sim_world.h"
+
+namespace slamo::vision {
+namespace {
+
+using platform::Pose2D;
+using platform::SimObject;
+
+// Renders Toss Up with only the objects a test places, and detects on the frame.
+class DetectorTest : public ::testing::Test {
+ protected:
+  DetectorTest()
+      : season_(field::LoadSeasonConfig("toss_up")),
+        robot_(field::LoadRobotConfig("thesis_robot")),
+        setup_(ObjectDetectorSetup(season_, &robot_.camera)) {}
+
+  SimObject Ball(const std::string& type, const std::string& colour, double x, double y) {
+    SimObject o;
+    o.id = static_cast<int>(objects_.size()) + 1;
+    o.type = season_.FindObjectType(type);
+    o.colour = colour;
+    o.center_m = Eigen::Vector3d(x, y, o.type->size_m / 2.0);
+    objects_.push_back(o);
+    return o;
+  }
+
+  platform::RgbdFrame Render(const Pose2D& pose, platform::FrameTruth* truth = nullptr) {
+    platform::SimWorld world = platform::CreateWorld(season_, 3);
+    world.objects = objects_;
+    platform::SimRenderer renderer(season_, robot_.camera, platform::RenderOptions{}, 3);
+    return renderer.Render(world, pose, 0.0, truth);
+  }
+
+  std::vector<Detection> DetectColour(const platform::RgbdFrame& frame, const std::string& colour,
+                                      const DetectOptions& options = {}) {
+    std::vector<Detection> out;
+    for (Detection& d : Detect(frame.colour, frame.depth_mm, setup_, options)) {
+      if (d.colour == colour) out.push_back(std::move(d));
+    }
+    return out;
+  }
+
+  // Truth range and bearing of an object from a robot pose.
+  static Eigen::Vector2d TruthRangeBearing(const SimObject& o, const Pose2D& pose) {
+    const double dx = o.center_m.x() - pose.x_m, dy = o.center_m.y() - pose.y_m;
+    return Eigen::Vector2d(std::hypot(dx, dy),
+                           platform::WrapAngleRad(std::atan2(dy, dx) - pose.theta_rad));
+  }
+
+  field::SeasonConfig season_;
+  field::RobotConfig robot_;
+  DetectorSetup setup_;
+  std::vector<SimObject> objects_;
+  const Pose2D pose_{-1.5, 0.0, 0.0};
+};
+
+TEST_F(DetectorTest, SolidBallFoundWithRangeAndBearing) {
+  const SimObject ball = Ball("buckyball", "red", -0.4, 0.2);
+  const platform::RgbdFrame frame = Render(pose_);
+  const std::vector<Detection> found = DetectColour(frame, "red");
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].kind, "buckyball");
+  ASSERT_TRUE(found[0].measurement.has_value());
+  const Eigen::Vector2d truth = TruthRangeBearing(ball, pose_);
+  EXPECT_NEAR(found[0].measurement->range_m, truth.x(), 0.02);
+  EXPECT_NEAR(found[0].measurement->bearing_rad, truth.y(), 0.01);
+  // The covariance is a covariance.
+  const Eigen::Matrix2d& c = found[0].measurement->covariance;
+  EXPECT_GT(c(0, 0), 0.0);
+  EXPECT_GT(c(1, 1), 0.0);
+  EXPECT_GT(c.determinant(), 0.0);
+}
+
+// The thesis's erosion erased every ball beyond 2 m; size-aware cleaning keeps them.
+TEST_F(DetectorTest, FarBallAtThreeMetresIsFound) {
+  // From a corner across the near half (the barrier would hide the far half's floor).
+  const SimObject ball = Ball("buckyball", "blue", 0.3, 0.9);
+  const Pose2D corner{-1.5, -1.5, std::atan2(2.4, 1.8)};
+  ASSERT_NEAR(TruthRangeBearing(ball, corner).x(), 3.0, 0.01);
+  const platform::RgbdFrame frame = Render(corner);
+  const std::vector<Detection> found = DetectColour(frame, "blue");
+  ASSERT_EQ(found.size(), 1u);
+  ASSERT_TRUE(found[0].measurement.has_value());
+  EXPECT_NEAR(found[0].measurement->range_m, TruthRangeBearing(ball, corner).x(), 0.05);
+}
+
+TEST_F(DetectorTest, SemiTransparentBallKMeansCoversMoreThanThreshold) {
+  Ball("large_ball", "blue", -0.2, 0.3);
+  platform::FrameTruth truth;
+  const platform::RgbdFrame frame = Render(pose_, &truth);
+  const cv::Mat body = truth.ids == 1;
+  const auto coverage = [&](DetectMethod method) {
+    DetectOptions options;
+    options.method = method;
+    const std::vector<cv::Mat> masks = ColourMasks(frame.colour, setup_, options);
+    size_t blue = 0;
+    while (setup_.colours[blue].name != "blue") ++blue;
+    return static_cast<double>(cv::countNonZero(masks[blue] & body)) / cv::countNonZero(body);
+  };
+  const double threshold = coverage(DetectMethod::kThreshold);
+  const double kmeans = coverage(DetectMethod::kKMeans);
+  EXPECT_GT(kmeans, threshold + 0.15) << "threshold " << threshold << ", kmeans " << kmeans;
+  DetectOptions options;
+  options.method = DetectMethod::kKMeans;
+  const std::vector<Detection> found = DetectColour(frame, "blue", options);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].kind, "large_ball");
+}
+
+TEST_F(DetectorTest, TwoTouchingBallsAreSplit) {
+  Ball("buckyball", "red", -0.5, 0.0635);
+  Ball("buckyball", "red", -0.5, -0.0635);
+  const platform::RgbdFrame frame = Render(pose_);
+  DetectOptions options;
+  options.separation = SeparationMethod::kNone;
+  // Unsplit, the pair is one blob that is not round: no detection at all.
+  EXPECT_TRUE(DetectColour(frame, "red", options).empty());
+  options.separation = SeparationMethod::kConcaveDefects;
+  const std::vector<Detection> split = DetectColour(frame, "red", options);
+  ASSERT_EQ(split.size(), 2u);
+  for (const Detection& d : split) {
+    ASSERT_TRUE(d.measurement.has_value());
+    EXPECT_NEAR(std::abs(d.measurement->position_robot_m.y()), 0.0635, 0.03);
+  }
+}
+
+TEST_F(DetectorTest, ThreeTouchingBallsAreSplit) {
+  for (int k = -1; k <= 1; ++k) Ball("buckyball", "blue", -0.6, 0.127 * k);
+  const platform::RgbdFrame frame = Render(pose_);
+  EXPECT_EQ(DetectColour(frame, "blue").size(), 3u);
+}
+
+TEST_F(DetectorTest, PartlyOccludedBallIsStillFound) {
+  Ball("buckyball", "red", -0.6, 0.0);     // in front
+  Ball("buckyball", "blue", -0.35, 0.09);  // behind, partly hidden by the red one
+  const platform::RgbdFrame frame = Render(pose_);
+  EXPECT_EQ(DetectColour(frame, "red").size(), 1u);
+  EXPECT_EQ(DetectColour(frame, "blue").size(), 1u);
+}
+
+// The red goal is red, tall and not round: it is not a ball.
+TEST_F(DetectorTest, SameColouredStructureIsRejected) {
+  const Pose2D facing_goal{-0.6, 0.61, 0.0};  // the red stash 1 m ahead
+  const platform::RgbdFrame frame = Render(facing_goal);
+  DetectStats stats;
+  const std::vector<Detection> all = Detect(frame.colour, frame.depth_mm, setup_, {}, &stats);
+  for (const Detection& d : all) EXPECT_NE(d.colour, "red") << d.centre_px;
+  EXPECT_GT(stats.rejected_shape + stats.rejected_size, 0);
+}
+
+TEST_F(DetectorTest, NoDepthMeansNoMeasurementNeverNaN) {
+  Ball("buckyball", "red", -0.4, 0.2);
+  const platform::RgbdFrame frame = Render(pose_);
+  const cv::Mat zero_depth(frame.depth_mm.size(), CV_16UC1, cv::Scalar(0));
+  DetectStats stats;
+  std::vector<Detection> found = Detect(frame.colour, zero_depth, setup_, {}, &stats);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_FALSE(found[0].measurement.has_value());
+  EXPECT_EQ(stats.without_depth, 1);
+  // Colour only (a photo): found, no range.
+  found = Detect(frame.colour, cv::Mat(), setup_, {});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_FALSE(found[0].measurement.has_value());
+}
+
+TEST_F(DetectorTest, BadInputIsAClearError) {
+  const platform::RgbdFrame frame = Render(pose_);
+  EXPECT_THROW(Detect(cv::Mat(), cv::Mat(), setup_, {}), std::invalid_argument);
+  cv::Mat grey;
+  cv::extractChannel(frame.colour, grey, 0);
+  EXPECT_THROW(Detect(grey, cv::Mat(), setup_, {}), std::invalid_argument);
+  cv::Mat depth8;
+  frame.depth_mm.convertTo(depth8, CV_8U, 1.0 / 16.0);
+  EXPECT_THROW(Detect(frame.colour, depth8, setup_, {}), std::invalid_argument);
+  const cv::Mat small_depth(100, 100, CV_16UC1, cv::Scalar(1000));
+  EXPECT_THROW(Detect(frame.colour, small_depth, setup_, {}), std::invalid_argument);
+}
+
+TEST(ColourClassesTest, RedHueWrapsAroundZero) {
+  const ColourClass red = MakeColourClass("red", field::Rgb{220, 20, 40});  // hue ~354 deg
+  cv::Mat hsv(1, 2, CV_8UC3);
+  hsv.at<cv::Vec3b>(0, 0) = cv::Vec3b(2, 200, 200);    // hue 4 deg
+  hsv.at<cv::Vec3b>(0, 1) = cv::Vec3b(176, 200, 200);  // hue 352 deg
+  const cv::Mat mask = ThresholdHsv(hsv, red);
+  EXPECT_EQ(mask.at<uint8_t>(0, 0), 255);
+  EXPECT_EQ(mask.at<uint8_t>(0, 1), 255);
+  EXPECT_THROW(MakeColourClass("grey", field::Rgb{128, 128, 128}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace slamo::vision

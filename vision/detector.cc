@@ -1,0 +1,492 @@
+#include "vision/detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+namespace slamo::vision {
+namespace {
+
+void CheckInput(const cv::Mat& bgr, const cv::Mat& depth_mm) {
+  if (bgr.empty()) throw std::invalid_argument("the colour image is empty");
+  if (bgr.type() != CV_8UC3) {
+    throw std::invalid_argument("the colour image must be 8-bit, 3-channel BGR");
+  }
+  if (depth_mm.empty()) return;
+  if (depth_mm.type() != CV_16UC1) {
+    throw std::invalid_argument(
+        "the depth image must be 16-bit single-channel millimetres (an 8-bit depth image has "
+        "lost its scale)");
+  }
+  if (depth_mm.size() != bgr.size()) {
+    throw std::invalid_argument("the depth image (" + std::to_string(depth_mm.cols) + "x" +
+                                std::to_string(depth_mm.rows) +
+                                ") must be registered to the colour image (" +
+                                std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) + ")");
+  }
+}
+
+// Median of the valid depth readings under a mask, raw millimetres; 0 when none.
+double MedianDepthMm(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box) {
+  std::vector<uint16_t> readings;
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    const uint8_t* m = mask.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      if (m[u] && d[u]) readings.push_back(d[u]);
+    }
+  }
+  if (readings.empty()) return 0.0;
+  std::nth_element(readings.begin(), readings.begin() + readings.size() / 2, readings.end());
+  return readings[readings.size() / 2];
+}
+
+// A circle fitted (algebraic least squares, Kasa) to outline points.
+struct ArcFit {
+  cv::Point2d centre;
+  double radius = 0.0;
+  double rms = 0.0;           // of the points' distance to the circle
+  double coverage_deg = 0.0;  // 360 minus the largest angular gap between points
+};
+
+std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
+  if (points.size() < 8) return std::nullopt;
+  cv::Point2d mean(0, 0);
+  for (const cv::Point& p : points) mean += cv::Point2d(p);
+  mean *= 1.0 / points.size();
+  const int n = static_cast<int>(points.size());
+  cv::Mat a(n, 3, CV_64F), b(n, 1, CV_64F);
+  for (int i = 0; i < n; ++i) {
+    const double x = points[i].x - mean.x, y = points[i].y - mean.y;
+    a.at<double>(i, 0) = x;
+    a.at<double>(i, 1) = y;
+    a.at<double>(i, 2) = 1.0;
+    b.at<double>(i, 0) = -(x * x + y * y);
+  }
+  cv::Mat solution;
+  if (!cv::solve(a, b, solution, cv::DECOMP_SVD)) return std::nullopt;
+  const double cx = -solution.at<double>(0) / 2.0, cy = -solution.at<double>(1) / 2.0;
+  const double r2 = cx * cx + cy * cy - solution.at<double>(2);
+  if (!(r2 > 0.0)) return std::nullopt;
+  ArcFit fit;
+  fit.centre = mean + cv::Point2d(cx, cy);
+  fit.radius = std::sqrt(r2);
+  std::vector<double> angles;
+  double sum2 = 0.0;
+  for (const cv::Point& p : points) {
+    const cv::Point2d d = cv::Point2d(p) - fit.centre;
+    const double e = std::hypot(d.x, d.y) - fit.radius;
+    sum2 += e * e;
+    angles.push_back(std::atan2(d.y, d.x));
+  }
+  fit.rms = std::sqrt(sum2 / points.size());
+  std::sort(angles.begin(), angles.end());
+  double gap = 2.0 * M_PI - (angles.back() - angles.front());
+  for (size_t i = 1; i < angles.size(); ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
+  fit.coverage_deg = 360.0 - gap * 180.0 / M_PI;
+  return fit;
+}
+
+// A circle through an outline whose points may include straight stretches where something
+// else hides the object (a barrier's edge): fit, keep the points near the circle, refit.
+// `inlier_fraction` reports how much of the outline the final circle explains.
+std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlier_fraction) {
+  std::optional<ArcFit> fit = FitCircle(points);
+  std::vector<cv::Point> inliers = points;
+  for (int round = 0; fit && round < 3; ++round) {
+    const double tolerance = std::max(1.5, 0.08 * fit->radius);
+    std::vector<cv::Point> kept;
+    for (const cv::Point& p : points) {
+      const cv::Point2d d = cv::Point2d(p) - fit->centre;
+      if (std::abs(std::hypot(d.x, d.y) - fit->radius) < tolerance) kept.push_back(p);
+    }
+    if (kept.size() == inliers.size() || kept.size() < 8) break;
+    inliers = std::move(kept);
+    fit = FitCircle(inliers);
+  }
+  *inlier_fraction = points.empty() ? 0.0 : static_cast<double>(inliers.size()) / points.size();
+  return fit;
+}
+
+std::vector<TargetKind> KindsOf(const DetectorSetup& setup, const std::string& colour) {
+  std::vector<TargetKind> out;
+  for (const TargetKind& k : setup.kinds) {
+    if (k.colour == colour) out.push_back(k);
+  }
+  return out;
+}
+
+cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const DetectOptions& options,
+                     std::vector<int>* cluster_class, cv::Size* small_size) {
+  const int ds = std::max(1, options.kmeans_downsample);
+  cv::Mat small;
+  cv::resize(bgr, small, cv::Size(bgr.cols / ds, bgr.rows / ds), 0, 0, cv::INTER_AREA);
+  *small_size = small.size();
+  cv::Mat lab;
+  cv::cvtColor(small, lab, cv::COLOR_BGR2Lab);
+  // Chromatic pixels only: greys (floor, walls, white reflections) carry no hue.
+  std::vector<cv::Vec2f> samples;
+  std::vector<int> index;
+  const float min_chroma2 =
+      static_cast<float>(options.kmeans_min_chroma * options.kmeans_min_chroma);
+  for (int i = 0; i < lab.rows * lab.cols; ++i) {
+    const cv::Vec3b p = lab.at<cv::Vec3b>(i / lab.cols, i % lab.cols);
+    const cv::Vec2f ab(p[1] - 128.0f, p[2] - 128.0f);
+    if (ab.dot(ab) >= min_chroma2) samples.push_back(ab), index.push_back(i);
+  }
+  cv::Mat labels_small(small.size(), CV_32SC1, cv::Scalar(-1));
+  const int k = static_cast<int>(setup.colours.size() + setup.distractors.size()) +
+                options.kmeans_extra_clusters;
+  cluster_class->assign(k, -1);
+  if (static_cast<int>(samples.size()) < k) return labels_small;
+  cv::Mat data(static_cast<int>(samples.size()), 2, CV_32F, samples.data());
+  cv::Mat labels, centres;
+  cv::theRNG().state = options.seed;  // kmeans++ starts from OpenCV's RNG: seed it
+  cv::kmeans(data, k, labels,
+             cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
+                              options.kmeans_iterations, 0.5),
+             1, cv::KMEANS_PP_CENTERS, centres);
+  // Each cluster joins the class whose hue angle in the a*b* plane is nearest, within a
+  // tolerance. The angle, not the distance: a semi-transparent ball has its colour's hue at
+  // a fraction of its chroma (the background shows through).
+  for (int c = 0; c < k; ++c) {
+    const double centre_angle = std::atan2(centres.at<float>(c, 1), centres.at<float>(c, 0));
+    double best = options.kmeans_max_angle_deg * M_PI / 180.0;
+    const size_t targets = setup.colours.size();
+    for (size_t j = 0; j < targets + setup.distractors.size(); ++j) {
+      const ColourClass& colour = j < targets ? setup.colours[j] : setup.distractors[j - targets];
+      const cv::Vec2f ref = colour.lab_ab - cv::Vec2f(128.0f, 128.0f);
+      const double diff =
+          std::abs(std::remainder(centre_angle - std::atan2(ref[1], ref[0]), 2.0 * M_PI));
+      if (diff < best) best = diff, (*cluster_class)[c] = j < targets ? static_cast<int>(j) : -1;
+    }
+  }
+  for (size_t s = 0; s < index.size(); ++s) {
+    labels_small.at<int>(index[s] / small.cols, index[s] % small.cols) =
+        labels.at<int>(static_cast<int>(s));
+  }
+  return labels_small;
+}
+
+// The season's other saturated colours, for K-Means to give their clusters to.
+std::vector<ColourClass> Distractors(const field::SeasonConfig& season,
+                                     const std::vector<ColourClass>& targets) {
+  std::vector<ColourClass> out;
+  for (const auto& [name, rgb] : season.colours) {
+    if (std::any_of(targets.begin(), targets.end(),
+                    [&](const ColourClass& c) { return c.name == name; })) {
+      continue;
+    }
+    try {
+      out.push_back(MakeColourClass(name, rgb));
+    } catch (const std::invalid_argument&) {
+      // A grey: never clustered (below the chroma floor).
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+DetectMethod ParseDetectMethod(const std::string& name) {
+  if (name == "threshold") return DetectMethod::kThreshold;
+  if (name == "kmeans") return DetectMethod::kKMeans;
+  throw std::invalid_argument("unknown detection method '" + name +
+                              "': expected threshold or kmeans");
+}
+
+const char* ToString(DetectMethod method) {
+  return method == DetectMethod::kThreshold ? "threshold" : "kmeans";
+}
+
+DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
+                                  const field::CameraConfig* camera) {
+  DetectorSetup setup;
+  setup.colours = ObjectColourClasses(season);
+  for (const field::ObjectType& type : season.object_types) {
+    for (const std::string& colour : type.colours) {
+      TargetKind k;
+      k.name = type.name;
+      k.colour = colour;
+      k.radius_m = type.size_m / 2.0;
+      const bool round =
+          type.shape == field::ObjectShape::kSphere || type.shape == field::ObjectShape::kTriball;
+      k.surface_to_centre_m =
+          round ? type.size_m / 2.0 : std::min(type.size_m, type.height_m) / 2.0;
+      // Round things look round from anywhere; cubes are squares (0.785), rings, stars and
+      // blocks seen from a low camera are flat shapes.
+      k.min_circularity = round ? 0.6 : 0.3;
+      k.round = round;
+      setup.kinds.push_back(k);
+    }
+  }
+  setup.distractors = Distractors(season, setup.colours);
+  if (camera) setup.camera = CameraModel(*camera);
+  return setup;
+}
+
+DetectorSetup LandmarkDetectorSetup(const field::SeasonConfig& season,
+                                    const field::CameraConfig* camera) {
+  DetectorSetup setup;
+  setup.colours = LandmarkColourClasses(season);
+  for (const field::Landmark& l : season.landmarks) {
+    TargetKind k;
+    k.name = "landmark";
+    k.colour = l.colour;
+    k.radius_m = l.size_m / 2.0;
+    k.surface_to_centre_m =
+        l.shape == field::LandmarkShape::kSphere || l.shape == field::LandmarkShape::kCylinder
+            ? l.size_m / 2.0
+            : 0.0;
+    // Discs on a wall seen at an angle are ellipses.
+    k.min_circularity = 0.45;
+    k.round = false;
+    const bool duplicate = std::any_of(
+        setup.kinds.begin(), setup.kinds.end(),
+        [&](const TargetKind& o) { return o.colour == k.colour && o.radius_m == k.radius_m; });
+    if (!duplicate) setup.kinds.push_back(k);
+  }
+  setup.distractors = Distractors(season, setup.colours);
+  if (camera) setup.camera = CameraModel(*camera);
+  return setup;
+}
+
+DetectorSetup PhotoDetectorSetup(std::vector<ColourClass> colours) {
+  DetectorSetup setup;
+  setup.colours = std::move(colours);
+  for (const ColourClass& c : setup.colours) {
+    TargetKind k;
+    k.name = "object";
+    k.colour = c.name;
+    k.min_circularity = 0.6;
+    setup.kinds.push_back(k);
+  }
+  return setup;
+}
+
+std::vector<cv::Mat> ColourMasks(const cv::Mat& bgr, const DetectorSetup& setup,
+                                 const DetectOptions& options) {
+  std::vector<cv::Mat> masks;
+  if (options.method == DetectMethod::kThreshold) {
+    cv::Mat hsv;
+    cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
+    for (const ColourClass& c : setup.colours) masks.push_back(ThresholdHsv(hsv, c));
+  } else {
+    std::vector<int> cluster_class;
+    cv::Size small_size;
+    const cv::Mat labels = KMeansLabels(bgr, setup, options, &cluster_class, &small_size);
+    for (size_t j = 0; j < setup.colours.size(); ++j) {
+      cv::Mat small(small_size, CV_8UC1, cv::Scalar(0));
+      for (int v = 0; v < labels.rows; ++v) {
+        const int* l = labels.ptr<int>(v);
+        uint8_t* m = small.ptr<uint8_t>(v);
+        for (int u = 0; u < labels.cols; ++u) {
+          if (l[u] >= 0 && cluster_class[l[u]] == static_cast<int>(j)) m[u] = 255;
+        }
+      }
+      cv::Mat full;
+      cv::resize(small, full, bgr.size(), 0, 0, cv::INTER_LINEAR);
+      cv::threshold(full, full, 127, 255, cv::THRESH_BINARY);
+      masks.push_back(full);
+    }
+  }
+  // Remove speckle only; object-scale cleaning happens per blob, at its depth.
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3));
+  for (cv::Mat& m : masks) cv::morphologyEx(m, m, cv::MORPH_OPEN, kernel);
+  return masks;
+}
+
+std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
+                              const DetectorSetup& setup, const DetectOptions& options,
+                              DetectStats* stats) {
+  CheckInput(bgr, depth_mm);
+  DetectStats local;
+  DetectStats& st = stats ? *stats : local;
+  const bool have_depth = !depth_mm.empty() && setup.camera.has_value();
+  const double focal = setup.camera ? setup.camera->config().fx : 0.0;
+  const std::vector<cv::Mat> masks = ColourMasks(bgr, setup, options);
+  std::vector<Detection> out;
+
+  for (size_t j = 0; j < setup.colours.size(); ++j) {
+    const ColourClass& colour = setup.colours[j];
+    const std::vector<TargetKind> kinds = KindsOf(setup, colour.name);
+    if (kinds.empty()) continue;
+    double min_circularity = 1.0;
+    for (const TargetKind& k : kinds)
+      min_circularity = std::min(min_circularity, k.min_circularity);
+
+    std::vector<std::vector<cv::Point>> blobs;
+    cv::findContours(masks[j].clone(), blobs, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    for (const std::vector<cv::Point>& blob : blobs) {
+      const double blob_area = cv::contourArea(blob);
+      if (blob_area < options.min_area_px) {
+        ++st.rejected_small;
+        continue;
+      }
+      ++st.blobs;
+      // The blob, filled (highlights and reflections inside it are part of the object), in
+      // a padded window of its own.
+      const cv::Rect box = cv::boundingRect(blob) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+      const cv::Rect window =
+          (box + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+      cv::Mat blob_mask(window.size(), CV_8UC1, cv::Scalar(0));
+      cv::drawContours(blob_mask, std::vector<std::vector<cv::Point>>{blob}, 0, cv::Scalar(255),
+                       cv::FILLED, cv::LINE_8, cv::noArray(), 0, -window.tl());
+
+      // At its depth, how big should it be? Too small for every kind: noise (not eroded
+      // away at a fixed size, which erased far balls in the thesis).
+      double expected_radius_px = 0.0;
+      if (have_depth) {
+        const double raw =
+            MedianDepthMm(depth_mm(window), blob_mask, cv::Rect(cv::Point(), window.size()));
+        if (raw > 0.0) {
+          const double z = setup.camera->CorrectDepthM(raw);
+          for (const TargetKind& k : kinds) {
+            if (k.radius_m > 0.0)
+              expected_radius_px =
+                  std::max(expected_radius_px, focal * k.radius_m / (z + k.surface_to_centre_m));
+          }
+          double smallest = std::numeric_limits<double>::infinity();
+          for (const TargetKind& k : kinds) {
+            if (k.radius_m > 0.0)
+              smallest = std::min(smallest, focal * k.radius_m / (z + k.surface_to_centre_m));
+          }
+          if (std::isfinite(smallest) &&
+              blob_area < options.min_expected_area_ratio * M_PI * smallest * smallest) {
+            ++st.rejected_small;
+            continue;
+          }
+          // K-Means masks have gaps at reflections on the rim: close them at the object's scale.
+          if (options.method == DetectMethod::kKMeans && expected_radius_px > 6.0) {
+            const int k = std::max(3, static_cast<int>(0.15 * expected_radius_px) | 1);
+            cv::morphologyEx(blob_mask, blob_mask, cv::MORPH_CLOSE,
+                             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+          }
+        }
+      }
+
+      // The blob's own outline (not cuts, not the image border): where arcs of objects show.
+      cv::Mat outline(window.size(), CV_8UC1, cv::Scalar(0));
+      cv::drawContours(outline, std::vector<std::vector<cv::Point>>{blob}, 0, cv::Scalar(255), 3,
+                       cv::LINE_8, cv::noArray(), 0, -window.tl());
+      const bool all_round =
+          std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
+
+      // Touching objects: one piece each.
+      const SeparationResult separated =
+          SeparateTouching(blob_mask, options.separation, options.separation_options);
+      const bool split = separated.pieces.size() > 1;
+      for (std::vector<cv::Point> piece : separated.pieces) {
+        ++st.pieces;
+        for (cv::Point& p : piece) p += window.tl();
+        Detection d;
+        d.colour = colour.name;
+        d.split = split;
+        d.area_px = cv::contourArea(piece);
+        if (d.area_px < options.min_area_px) {
+          ++st.rejected_small;
+          continue;
+        }
+        const double perimeter = cv::arcLength(piece, true);
+        d.circularity = perimeter > 0.0 ? 4.0 * M_PI * d.area_px / (perimeter * perimeter) : 0.0;
+        d.box = cv::boundingRect(piece);
+        if (all_round) {
+          // Round objects: a circle through the visible arcs of the outline gives the centre
+          // and radius even when a cut, another object or the image border hides part of it.
+          std::vector<cv::Point> arc;
+          for (const cv::Point& p : piece) {
+            const cv::Point local = p - window.tl();
+            const bool on_border =
+                p.x <= 1 || p.y <= 1 || p.x >= bgr.cols - 2 || p.y >= bgr.rows - 2;
+            if (!on_border && outline.at<uint8_t>(local)) arc.push_back(p);
+          }
+          double inliers = 0.0;
+          const std::optional<ArcFit> fit = FitArc(arc, &inliers);
+          if (!fit || inliers < options.min_arc_inlier_fraction ||
+              fit->rms > options.max_arc_rms_ratio * fit->radius ||
+              fit->coverage_deg < options.min_arc_coverage_deg ||
+              fit->radius > 2.0 * std::sqrt(d.area_px / M_PI) + 2.0) {
+            ++st.rejected_shape;
+            continue;
+          }
+          d.centre_px = fit->centre;
+          d.radius_px = fit->radius;
+          d.score =
+              std::clamp(1.0 - fit->rms / (options.max_arc_rms_ratio * fit->radius), 0.0, 1.0) *
+              std::min(1.0, fit->coverage_deg / 360.0 + 0.25);
+        } else {
+          if (d.circularity < min_circularity) {
+            ++st.rejected_shape;
+            continue;
+          }
+          const cv::Moments m = cv::moments(piece);
+          d.centre_px = cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
+          d.radius_px = std::sqrt(d.area_px / M_PI);
+          d.score = std::min(1.0, d.circularity / 0.785);
+        }
+        d.contour = piece;
+
+        if (have_depth) {
+          cv::Mat piece_mask(bgr.size(), CV_8UC1, cv::Scalar(0));
+          cv::drawContours(piece_mask, std::vector<std::vector<cv::Point>>{piece}, 0,
+                           cv::Scalar(255), cv::FILLED);
+          // The kind whose size fits best.
+          const std::optional<Measurement> surface =
+              MeasureBlob(depth_mm, piece_mask, d.centre_px, 0.0, d.radius_px, *setup.camera,
+                          options.measurement);
+          if (!surface) {
+            ++st.without_depth;
+          } else {
+            const TargetKind* best = nullptr;
+            double best_ratio = options.size_tolerance;
+            for (const TargetKind& k : kinds) {
+              if (k.radius_m <= 0.0) continue;
+              const double expected =
+                  focal * k.radius_m / (surface->depth_m + k.surface_to_centre_m);
+              const double ratio = std::max(d.radius_px / expected, expected / d.radius_px);
+              if (ratio < best_ratio) best_ratio = ratio, best = &k;
+            }
+            if (!best) {
+              ++st.rejected_size;
+              continue;
+            }
+            d.kind = best->name;
+            d.measurement =
+                MeasureBlob(depth_mm, piece_mask, d.centre_px, best->surface_to_centre_m,
+                            d.radius_px, *setup.camera, options.measurement);
+          }
+        }
+        out.push_back(std::move(d));
+      }
+    }
+  }
+  return out;
+}
+
+cv::Mat DrawDetections(const cv::Mat& bgr, const std::vector<Detection>& detections) {
+  cv::Mat out = bgr.clone();
+  for (const Detection& d : detections) {
+    const cv::Scalar colour = d.split ? cv::Scalar(0, 255, 255) : cv::Scalar(0, 255, 0);
+    cv::drawContours(out, std::vector<std::vector<cv::Point>>{d.contour}, 0, colour, 2,
+                     cv::LINE_AA);
+    cv::circle(out, d.centre_px, 3, cv::Scalar(255, 255, 255), cv::FILLED, cv::LINE_AA);
+    char text[96];
+    if (d.measurement) {
+      std::snprintf(text, sizeof(text), "%s %s %.2fm %.0fdeg", d.colour.c_str(), d.kind.c_str(),
+                    d.measurement->range_m, d.measurement->bearing_rad * 180.0 / M_PI);
+    } else {
+      std::snprintf(text, sizeof(text), "%s", d.colour.c_str());
+    }
+    const cv::Point at(static_cast<int>(d.box.x), std::max(12, d.box.y - 4));
+    cv::putText(out, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+    cv::putText(out, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 255, 255), 1,
+                cv::LINE_AA);
+  }
+  return out;
+}
+
+}  // namespace slamo::vision

@@ -1,0 +1,111 @@
+// Object and landmark detection on a colour frame (and its registered depth, when there is
+// one): per colour class a mask from the HSV threshold or from K-Means colour clustering,
+// blobs cleaned at the scale of the object expected at their depth, touching objects split
+// (concave defects or watershed), shape and size filtering, and a range-bearing measurement
+// for each detection with depth.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "field_configs/robot_config.h"
+#include "field_configs/season_config.h"
+#include "vision/camera_model.h"
+#include "vision/colour_classes.h"
+#include "vision/measurement.h"
+#include "vision/separation.h"
+
+namespace slamo::vision {
+
+enum class DetectMethod { kThreshold, kKMeans };
+DetectMethod ParseDetectMethod(const std::string& name);  // "threshold" | "kmeans"
+const char* ToString(DetectMethod method);
+
+struct DetectOptions {
+  DetectMethod method = DetectMethod::kThreshold;
+  SeparationMethod separation = SeparationMethod::kConcaveDefects;
+  SeparationOptions separation_options;
+  MeasurementOptions measurement;
+  double min_area_px = 25.0;              // blobs below this are noise at any distance
+  double min_expected_area_ratio = 0.15;  // with depth: blobs below this x the expected area go
+  double size_tolerance = 1.8;  // with depth: apparent radius within [1/x, x] of an object's
+  // Round kinds: a circle fitted to the blob's outline (not the image border or a cut) must
+  // fit within this x its radius (rms) and cover at least this much of the circle.
+  double max_arc_rms_ratio = 0.1;
+  double min_arc_coverage_deg = 120.0;
+  double min_arc_inlier_fraction = 0.5;  // share of the outline on the circle
+  // K-Means (thesis 5.2.2): clustering of the chromatic pixels in Lab a*b*.
+  int kmeans_downsample = 2;           // cluster on an image this many times smaller
+  int kmeans_extra_clusters = 2;       // k = colour classes + this
+  double kmeans_min_chroma = 10.0;     // pixels greyer than this (a*b* radius) are not clustered
+  double kmeans_max_angle_deg = 25.0;  // a cluster joins the class nearest in a*b* hue angle
+  int kmeans_iterations = 10;
+  uint64_t seed = 1;
+};
+
+// One kind of thing to find: an object type in one colour, or a landmark.
+struct TargetKind {
+  std::string name;                  // object type or "landmark"
+  std::string colour;                // a class name
+  double radius_m = 0.0;             // apparent radius (half the size)
+  double surface_to_centre_m = 0.0;  // from the visible surface to the centre
+  double min_circularity = 0.6;      // 4 pi A / P^2 of an unoccluded view (flat kinds)
+  bool round = true;                 // looks like a disc from anywhere: judged by a circle fit
+};
+
+struct DetectorSetup {
+  std::vector<ColourClass> colours;
+  // Other colours in the scene (landmarks, structures...): K-Means gives their clusters to
+  // them, not to the nearest target colour.
+  std::vector<ColourClass> distractors;
+  std::vector<TargetKind> kinds;
+  std::optional<CameraModel> camera;  // needed for depth; none for photos
+};
+
+DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
+                                  const field::CameraConfig* camera);
+DetectorSetup LandmarkDetectorSetup(const field::SeasonConfig& season,
+                                    const field::CameraConfig* camera);
+// For photos: colours from a colours file, any round object of those colours.
+DetectorSetup PhotoDetectorSetup(std::vector<ColourClass> colours);
+
+struct Detection {
+  std::string colour;
+  std::string kind;  // the best-fitting TargetKind by size with depth; "" without depth
+  cv::Point2d centre_px;
+  double radius_px = 0.0;
+  cv::Rect box;
+  double area_px = 0.0;
+  double circularity = 0.0;
+  double score = 0.0;  // circularity x fill of the enclosing circle, 0..1
+  std::vector<cv::Point> contour;
+  bool split = false;  // came from separating a blob of touching objects
+  std::optional<Measurement> measurement;
+};
+
+struct DetectStats {
+  int blobs = 0;
+  int pieces = 0;
+  int rejected_small = 0;
+  int rejected_shape = 0;
+  int rejected_size = 0;
+  int without_depth = 0;  // kept, but no range: no valid depth on them
+};
+
+// Throws std::invalid_argument for unusable input: an empty or non-BGR colour image, a depth
+// image that is not CV_16UC1 or not the colour image's size.
+std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
+                              const DetectorSetup& setup, const DetectOptions& options,
+                              DetectStats* stats = nullptr);
+
+// The per-class masks before blob analysis (for pictures and the evaluation).
+std::vector<cv::Mat> ColourMasks(const cv::Mat& bgr, const DetectorSetup& setup,
+                                 const DetectOptions& options);
+
+// The detections drawn over the colour image: contours, centres, labels.
+cv::Mat DrawDetections(const cv::Mat& bgr, const std::vector<Detection>& detections);
+
+}  // namespace slamo::vision

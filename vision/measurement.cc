@@ -1,0 +1,76 @@
+#include "vision/measurement.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+namespace slamo::vision {
+
+Eigen::Vector2d RangeBearing(const CameraModel& camera, double u, double v, double z_m) {
+  const Eigen::Vector3d p = camera.CameraToRobot(camera.BackProject(u, v, z_m));
+  return Eigen::Vector2d(std::hypot(p.x(), p.y()), std::atan2(p.y(), p.x()));
+}
+
+std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
+                                       const cv::Point2d& centre_px, double surface_to_centre_m,
+                                       double radius_px, const CameraModel& camera,
+                                       const MeasurementOptions& options) {
+  if (depth_mm.empty() || depth_mm.type() != CV_16UC1 || blob_mask.size() != depth_mm.size()) {
+    return std::nullopt;
+  }
+  // Valid readings inside the (eroded) blob; fall back to the whole blob when erosion
+  // leaves too few (small, far objects).
+  cv::Mat inner = blob_mask;
+  if (options.erode_px > 0) {
+    cv::Mat eroded;
+    cv::erode(blob_mask, eroded,
+              cv::getStructuringElement(
+                  cv::MORPH_ELLIPSE, cv::Size(2 * options.erode_px + 1, 2 * options.erode_px + 1)));
+    if (cv::countNonZero(eroded) >= options.min_depth_pixels) inner = eroded;
+  }
+  const cv::Rect box = cv::boundingRect(inner);
+  std::vector<uint16_t> readings;
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    const uint8_t* m = inner.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      if (m[u] && d[u]) readings.push_back(d[u]);
+    }
+  }
+  if (static_cast<int>(readings.size()) < options.min_depth_pixels) return std::nullopt;
+  std::nth_element(readings.begin(), readings.begin() + readings.size() / 2, readings.end());
+  const double surface_m = camera.CorrectDepthM(readings[readings.size() / 2]);
+  if (!(surface_m > 0.0)) return std::nullopt;
+
+  Measurement m;
+  m.depth_m = surface_m;
+  m.depth_pixels = static_cast<int>(readings.size());
+  // The centre lies about one radius behind the visible surface, along the ray.
+  const double z = surface_m + surface_to_centre_m;
+  m.position_camera_m = camera.BackProject(centre_px.x, centre_px.y, z);
+  m.position_robot_m = camera.CameraToRobot(m.position_camera_m);
+  const Eigen::Vector2d rb = RangeBearing(camera, centre_px.x, centre_px.y, z);
+  m.range_m = rb.x();
+  m.bearing_rad = rb.y();
+
+  // Covariance: first-order propagation of the pixel and depth uncertainty (numerical
+  // Jacobian of (u, v, z) -> (range, bearing)).
+  const double sigma_px = options.pixel_sigma_px + options.pixel_sigma_ratio * radius_px;
+  const double sigma_z = std::hypot(camera.DepthSigmaM(z), options.model_sigma_m);
+  Eigen::Matrix<double, 2, 3> jacobian;
+  const double steps[3] = {0.5, 0.5, 1e-3};
+  for (int k = 0; k < 3; ++k) {
+    double plus[3] = {centre_px.x, centre_px.y, z}, minus[3] = {centre_px.x, centre_px.y, z};
+    plus[k] += steps[k];
+    minus[k] -= steps[k];
+    jacobian.col(k) = (RangeBearing(camera, plus[0], plus[1], plus[2]) -
+                       RangeBearing(camera, minus[0], minus[1], minus[2])) /
+                      (2.0 * steps[k]);
+  }
+  const Eigen::Vector3d variances(sigma_px * sigma_px, sigma_px * sigma_px, sigma_z * sigma_z);
+  m.covariance = jacobian * variances.asDiagonal() * jacobian.transpose();
+  return m;
+}
+
+}  // namespace slamo::vision

@@ -1,0 +1,46 @@
+// A blob turned into what SLAM-O consumes: depth (median of the blob's valid readings,
+// corrected by the camera's linear model), back-projection, and range and bearing from the
+// robot's centre with a covariance from the camera's sigma(d) and the pixel uncertainty.
+// A blob without valid depth yields no measurement; it never yields a NaN.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "vision/camera_model.h"
+
+namespace slamo::vision {
+
+struct MeasurementOptions {
+  int min_depth_pixels = 5;        // fewer valid readings in the blob: no measurement
+  int erode_px = 2;                // shrink the blob first: its rim sees the background
+  double pixel_sigma_px = 1.0;     // centre uncertainty floor (px)
+  double pixel_sigma_ratio = 0.1;  // plus this x the blob radius (partial views, blur)
+  double model_sigma_m = 0.01;     // depth model error beyond sigma(d): surface vs centre, bias
+};
+
+struct Measurement {
+  double range_m = 0.0;      // from the robot's centre, in the floor plane
+  double bearing_rad = 0.0;  // counter-clockwise from the robot's heading
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();  // of (range, bearing)
+  Eigen::Vector3d position_camera_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d position_robot_m = Eigen::Vector3d::Zero();
+  double depth_m = 0.0;  // corrected median depth of the blob's surface
+  int depth_pixels = 0;  // valid readings used
+};
+
+// `blob_mask`: CV_8UC1 of the depth image's size, non-zero on the blob. `centre_px`: where
+// the object's centre projects. `surface_to_centre_m`: added to the surface depth to reach
+// the object's centre (its radius for a ball; 0 for a flat marker).
+std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
+                                       const cv::Point2d& centre_px, double surface_to_centre_m,
+                                       double radius_px, const CameraModel& camera,
+                                       const MeasurementOptions& options = {});
+
+// Range and bearing in the robot frame of a pixel with its (centre) depth.
+Eigen::Vector2d RangeBearing(const CameraModel& camera, double u, double v, double z_m);
+
+}  // namespace slamo::vision
