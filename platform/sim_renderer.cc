@@ -344,9 +344,10 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
     }
   }
   // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
-  // without a normal draw per pixel per frame. 2^20 draws is ~5 frames' worth of pixels.
+  // without a normal draw per pixel per frame. The pool holds four frames' worth of pixels
+  // (at least 2^20), so a frame's colour noise (3 per pixel) always fits after an offset.
   std::normal_distribution<float> normal(0.0f, 1.0f);
-  normal_pool_.resize(1 << 20);
+  normal_pool_.resize(std::max<size_t>(size_t{1} << 20, 4 * rays_cam_.size()));
   for (float& x : normal_pool_) x = normal(rng_);
   BuildStaticPrimitives();
   // sigma(d) per millimetre of depth, so the per-pixel noise needs no table search.

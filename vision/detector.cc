@@ -122,7 +122,9 @@ std::vector<TargetKind> KindsOf(const DetectorSetup& setup, const std::string& c
 
 cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const DetectOptions& options,
                      std::vector<int>* cluster_class, cv::Size* small_size) {
-  const int ds = std::max(1, options.kmeans_downsample);
+  const int ds = options.kmeans_downsample > 0
+                     ? options.kmeans_downsample
+                     : std::max(1, static_cast<int>(std::lround(bgr.cols / 256.0)));
   cv::Mat small;
   cv::resize(bgr, small, cv::Size(bgr.cols / ds, bgr.rows / ds), 0, 0, cv::INTER_AREA);
   *small_size = small.size();
@@ -133,23 +135,40 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
   std::vector<int> index;
   const float min_chroma2 =
       static_cast<float>(options.kmeans_min_chroma * options.kmeans_min_chroma);
-  for (int i = 0; i < lab.rows * lab.cols; ++i) {
-    const cv::Vec3b p = lab.at<cv::Vec3b>(i / lab.cols, i % lab.cols);
-    const cv::Vec2f ab(p[1] - 128.0f, p[2] - 128.0f);
-    if (ab.dot(ab) >= min_chroma2) samples.push_back(ab), index.push_back(i);
+  for (int v = 0; v < lab.rows; ++v) {
+    const cv::Vec3b* row = lab.ptr<cv::Vec3b>(v);
+    for (int u = 0; u < lab.cols; ++u) {
+      const cv::Vec2f ab(row[u][1] - 128.0f, row[u][2] - 128.0f);
+      if (ab.dot(ab) >= min_chroma2) samples.push_back(ab), index.push_back(v * lab.cols + u);
+    }
   }
   cv::Mat labels_small(small.size(), CV_32SC1, cv::Scalar(-1));
   const int k = static_cast<int>(setup.colours.size() + setup.distractors.size()) +
                 options.kmeans_extra_clusters;
   cluster_class->assign(k, -1);
   if (static_cast<int>(samples.size()) < k) return labels_small;
-  cv::Mat data(static_cast<int>(samples.size()), 2, CV_32F, samples.data());
-  cv::Mat labels, centres;
+  // The centres are learnt on an even subsample (at most kmeans_max_samples); every
+  // chromatic pixel then takes its nearest centre.
+  const size_t stride = std::max<size_t>(1, samples.size() / options.kmeans_max_samples);
+  std::vector<cv::Vec2f> fit_samples;
+  for (size_t s = 0; s < samples.size(); s += stride) fit_samples.push_back(samples[s]);
+  cv::Mat data(static_cast<int>(fit_samples.size()), 2, CV_32F, fit_samples.data());
+  cv::Mat fit_labels, centres;
   cv::theRNG().state = options.seed;  // kmeans++ starts from OpenCV's RNG: seed it
-  cv::kmeans(data, k, labels,
+  cv::kmeans(data, k, fit_labels,
              cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
                               options.kmeans_iterations, 0.5),
              1, cv::KMEANS_PP_CENTERS, centres);
+  std::vector<int> labels(samples.size());
+  for (size_t s = 0; s < samples.size(); ++s) {
+    float best = std::numeric_limits<float>::infinity();
+    for (int c = 0; c < k; ++c) {
+      const float dx = samples[s][0] - centres.at<float>(c, 0);
+      const float dy = samples[s][1] - centres.at<float>(c, 1);
+      const float d2 = dx * dx + dy * dy;
+      if (d2 < best) best = d2, labels[s] = c;
+    }
+  }
   // Each cluster joins the class whose hue angle in the a*b* plane is nearest, within a
   // tolerance. The angle, not the distance: a semi-transparent ball has its colour's hue at
   // a fraction of its chroma (the background shows through).
@@ -166,8 +185,7 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
     }
   }
   for (size_t s = 0; s < index.size(); ++s) {
-    labels_small.at<int>(index[s] / small.cols, index[s] % small.cols) =
-        labels.at<int>(static_cast<int>(s));
+    labels_small.at<int>(index[s] / small.cols, index[s] % small.cols) = labels[s];
   }
   return labels_small;
 }
@@ -371,14 +389,39 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
 
       // The blob's own outline (not cuts, not the image border): where arcs of objects show.
       cv::Mat outline(window.size(), CV_8UC1, cv::Scalar(0));
-      cv::drawContours(outline, std::vector<std::vector<cv::Point>>{blob}, 0, cv::Scalar(255), 3,
-                       cv::LINE_8, cv::noArray(), 0, -window.tl());
+      for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
+      cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
       const bool all_round =
           std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
-      // Touching objects: one piece each.
-      const SeparationResult separated =
-          SeparateTouching(blob_mask, options.separation, options.separation_options);
+      // Touching objects: one piece each. A blob that fills its convex hull is one object
+      // (two balls overlapping by 45 % of a diameter still fill only 97.8 %).
+      std::vector<cv::Point> hull;
+      cv::convexHull(blob, hull);
+      const bool convex = blob_area >= options.single_object_solidity * cv::contourArea(hull);
+      SeparationResult separated;
+      if (convex) {
+        std::vector<cv::Point> shifted = blob;
+        for (cv::Point& p : shifted) p -= window.tl();
+        separated.pieces.push_back(std::move(shifted));
+      } else if (blob_mask.total() > options.separation_max_pixels) {
+        // Large blobs are separated at a reduced scale: the cut positions need no more
+        // than a few hundred pixels across the blob.
+        const double scale =
+            std::sqrt(static_cast<double>(options.separation_max_pixels) / blob_mask.total());
+        cv::Mat small;
+        cv::resize(blob_mask, small, cv::Size(), scale, scale, cv::INTER_AREA);
+        cv::threshold(small, small, 127, 255, cv::THRESH_BINARY);
+        separated = SeparateTouching(small, options.separation, options.separation_options);
+        for (std::vector<cv::Point>& piece : separated.pieces) {
+          for (cv::Point& p : piece) {
+            p = cv::Point(static_cast<int>(std::lround((p.x + 0.5) / scale - 0.5)),
+                          static_cast<int>(std::lround((p.y + 0.5) / scale - 0.5)));
+          }
+        }
+      } else {
+        separated = SeparateTouching(blob_mask, options.separation, options.separation_options);
+      }
       const bool split = separated.pieces.size() > 1;
       for (std::vector<cv::Point> piece : separated.pieces) {
         ++st.pieces;
@@ -431,12 +474,17 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         d.contour = piece;
 
         if (have_depth) {
-          cv::Mat piece_mask(bgr.size(), CV_8UC1, cv::Scalar(0));
+          // The piece's own window: measuring never needs the whole image.
+          const int pad = options.measurement.erode_px + 2;
+          const cv::Rect roi = (d.box + cv::Size(2 * pad, 2 * pad) - cv::Point(pad, pad)) &
+                               cv::Rect(0, 0, bgr.cols, bgr.rows);
+          cv::Mat piece_mask(roi.size(), CV_8UC1, cv::Scalar(0));
           cv::drawContours(piece_mask, std::vector<std::vector<cv::Point>>{piece}, 0,
-                           cv::Scalar(255), cv::FILLED);
+                           cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0, -roi.tl());
+          const cv::Mat depth_roi = depth_mm(roi);
           // The kind whose size fits best.
           const std::optional<Measurement> surface =
-              MeasureBlob(depth_mm, piece_mask, d.centre_px, 0.0, d.radius_px, *setup.camera,
+              MeasureBlob(depth_roi, piece_mask, d.centre_px, 0.0, d.radius_px, *setup.camera,
                           options.measurement);
           if (!surface) {
             ++st.without_depth;
@@ -456,7 +504,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             }
             d.kind = best->name;
             d.measurement =
-                MeasureBlob(depth_mm, piece_mask, d.centre_px, best->surface_to_centre_m,
+                MeasureBlob(depth_roi, piece_mask, d.centre_px, best->surface_to_centre_m,
                             d.radius_px, *setup.camera, options.measurement);
           }
         }

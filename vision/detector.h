@@ -30,6 +30,8 @@ struct DetectOptions {
   SeparationOptions separation_options;
   MeasurementOptions measurement;
   double min_area_px = 25.0;              // blobs below this are noise at any distance
+  double single_object_solidity = 0.985;  // blobs filling this much of their hull: not split
+  size_t separation_max_pixels = 6000;    // larger blob windows are separated scaled down
   double min_expected_area_ratio = 0.15;  // with depth: blobs below this x the expected area go
   double size_tolerance = 1.8;  // with depth: apparent radius within [1/x, x] of an object's
   // Round kinds: a circle fitted to the blob's outline (not the image border or a cut) must
@@ -38,11 +40,13 @@ struct DetectOptions {
   double min_arc_coverage_deg = 120.0;
   double min_arc_inlier_fraction = 0.5;  // share of the outline on the circle
   // K-Means (thesis 5.2.2): clustering of the chromatic pixels in Lab a*b*.
-  int kmeans_downsample = 2;           // cluster on an image this many times smaller
+  int kmeans_downsample = 0;           // cluster on an image this many times smaller; 0: about
+                                       // 256 px wide (2x at 512x424, 8x at 1920x1080)
   int kmeans_extra_clusters = 2;       // k = colour classes + this
   double kmeans_min_chroma = 10.0;     // pixels greyer than this (a*b* radius) are not clustered
   double kmeans_max_angle_deg = 25.0;  // a cluster joins the class nearest in a*b* hue angle
   int kmeans_iterations = 10;
+  size_t kmeans_max_samples = 4000;  // centres are learnt on at most this many pixels
   uint64_t seed = 1;
 };
 

@@ -32,8 +32,9 @@ struct Measurement {
   int depth_pixels = 0;  // valid readings used
 };
 
-// `blob_mask`: CV_8UC1 of the depth image's size, non-zero on the blob. `centre_px`: where
-// the object's centre projects. `surface_to_centre_m`: added to the surface depth to reach
+// `blob_mask`: CV_8UC1 of the depth image's size, non-zero on the blob (both may be the same
+// window of the full images). `centre_px`: where the object's centre projects, in full-image
+// pixels. `surface_to_centre_m`: added to the surface depth to reach
 // the object's centre (its radius for a ball; 0 for a flat marker).
 std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
                                        const cv::Point2d& centre_px, double surface_to_centre_m,

@@ -274,3 +274,24 @@ TEST(SimRendererShapesTest, StarIsAStarPrismNotADisc) {
 
 }  // namespace
 }  // namespace slamo::platform
+
+namespace slamo::platform {
+namespace {
+
+// A camera at the Kinect V2 colour resolution renders too (the noise pool grows with it).
+TEST(SimRendererSizesTest, RendersAt1920x1080) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  field::CameraConfig camera = field::LoadRobotConfig("thesis_robot").camera;
+  const double sx = 1920.0 / camera.width_px, sy = 1080.0 / camera.height_px;
+  camera.width_px = 1920, camera.height_px = 1080;
+  camera.fx *= sx, camera.cx *= sx, camera.fy *= sy, camera.cy *= sy;
+  SimRenderer renderer(season, camera, RenderOptions{}, 1);
+  const RgbdFrame frame =
+      renderer.Render(CreateWorld(season, 1), Pose2D{-1.2, -0.5, 0.5}, 0.0, nullptr);
+  EXPECT_EQ(frame.colour.cols, 1920);
+  EXPECT_EQ(frame.depth_mm.rows, 1080);
+  EXPECT_GT(cv::countNonZero(frame.depth_mm), 1920 * 1080 / 4);
+}
+
+}  // namespace
+}  // namespace slamo::platform

@@ -1,0 +1,87 @@
+// Detection per frame, for each method, on a rendered Toss Up view with solid and
+// semi-transparent balls, at the depth camera's 512x424 and at 1920x1080 (the Kinect V2
+// colour resolution). One core.
+#include <benchmark/benchmark.h>
+
+#include <map>
+
+#include "field_configs/loader.h"
+#include "platform/sim_renderer.h"
+#include "vision/detector.h"
+
+namespace slamo::vision {
+namespace {
+
+struct Scene {
+  cv::Mat colour, depth;
+  DetectorSetup setup;
+};
+
+const Scene& SceneAt(int width) {
+  static std::map<int, Scene> scenes;
+  auto it = scenes.find(width);
+  if (it != scenes.end()) return it->second;
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+    if (width != robot.camera.width_px) {
+    // The Kinect V2 colour camera: 1920x1080, square pixels, fx = fy ~ 1081 px.
+    robot.camera.width_px = 1920, robot.camera.height_px = 1080;
+    robot.camera.fx = robot.camera.fy = 1081.37;
+    robot.camera.cx = 959.5, robot.camera.cy = 539.5;
+  }
+  const platform::SimWorld world = platform::CreateWorld(season, 1);
+  platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 1);
+  const platform::RgbdFrame frame =
+      renderer.Render(world, platform::Pose2D{-1.2, -0.5, 0.5}, 0.0, nullptr);
+  Scene scene{frame.colour, frame.depth_mm, ObjectDetectorSetup(season, &robot.camera)};
+  return scenes.emplace(width, std::move(scene)).first->second;
+}
+
+void BM_Detect(benchmark::State& state, DetectMethod method, SeparationMethod separation) {
+  const Scene& scene = SceneAt(static_cast<int>(state.range(0)));
+  DetectOptions options;
+  options.method = method;
+  options.separation = separation;
+  size_t found = 0;
+  for (auto _ : state) {
+    const std::vector<Detection> detections =
+        Detect(scene.colour, scene.depth, scene.setup, options);
+    found = detections.size();
+    benchmark::DoNotOptimize(found);
+  }
+  state.SetLabel(std::to_string(scene.colour.cols) + "x" + std::to_string(scene.colour.rows) +
+                 ", " + std::to_string(found) + " found");
+}
+
+BENCHMARK_CAPTURE(BM_Detect, threshold_defects, DetectMethod::kThreshold,
+                  SeparationMethod::kConcaveDefects)
+    ->Arg(512)
+    ->Arg(1920)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Detect, threshold_watershed, DetectMethod::kThreshold,
+                  SeparationMethod::kWatershed)
+    ->Arg(512)
+    ->Arg(1920)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Detect, kmeans_defects, DetectMethod::kKMeans,
+                  SeparationMethod::kConcaveDefects)
+    ->Arg(512)
+    ->Arg(1920)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Detect, kmeans_watershed, DetectMethod::kKMeans, SeparationMethod::kWatershed)
+    ->Arg(512)
+    ->Arg(1920)
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace slamo::vision
+
+// One core: OpenCV's own worker threads off.
+int main(int argc, char** argv) {
+  cv::setNumThreads(0);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
