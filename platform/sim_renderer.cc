@@ -416,6 +416,7 @@ void SimRenderer::BuildStaticPrimitives() {
       p.center = Vector3d(l.position_m.x, l.position_m.y, l.height_m);
     }
     SetAabb(&p);
+    landmark_centres_.push_back(p.center);
     static_primitives_.push_back(p);
   }
 }
@@ -809,8 +810,7 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
     for (size_t l = 0; l < season_.landmarks.size(); ++l) {
       const int id = kLandmarkIdBase + static_cast<int>(l);
       if (count[id] == 0) continue;
-      const field::Landmark& landmark = season_.landmarks[l];
-      const Vector3d position(landmark.position_m.x, landmark.position_m.y, landmark.height_m);
+      const Vector3d& position = landmark_centres_[l];
       truth->landmarks.push_back(
           {static_cast<int>(l), position, camera_from_world * position, count[id], boxes[id]});
     }

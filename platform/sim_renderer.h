@@ -52,8 +52,8 @@ struct ObjectTruth {
 };
 
 struct LandmarkTruth {
-  int index = 0;  // into SeasonConfig::landmarks
-  Eigen::Vector3d position_m;
+  int index = 0;               // into SeasonConfig::landmarks
+  Eigen::Vector3d position_m;  // where it is drawn (see SimRenderer::landmark_centres)
   Eigen::Vector3d position_cam_m;
   int pixels = 0;
   cv::Rect box;
@@ -81,6 +81,10 @@ class SimRenderer {
   // sigma of one depth reading at `depth_m`, from the camera's noise table.
   double DepthSigmaM(double depth_m) const;
 
+  // Where each season landmark is drawn (its centre): a disc or square marker sits on the
+  // inner face of the nearest wall, whatever its configured offset behind it.
+  const std::vector<Eigen::Vector3d>& landmark_centres() const { return landmark_centres_; }
+
   struct Primitive;  // internal geometry, public for the .cc's helpers
 
  private:
@@ -97,6 +101,7 @@ class SimRenderer {
   std::vector<float> ray_length2_;         // per pixel, |ray|^2 (the same in every frame)
   std::vector<float> normal_pool_;         // N(0, 1) draws, read from a random offset per frame
   std::vector<Primitive> static_primitives_;
+  std::vector<Eigen::Vector3d> landmark_centres_;
   std::vector<float> sigma_mm_by_mm_;        // sigma(d) in mm, indexed by depth in whole mm
   std::unique_ptr<Buffers> depth_buffers_;   // reused every frame
   std::unique_ptr<Buffers> colour_buffers_;  // with the colour-depth baseline only

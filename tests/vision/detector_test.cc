@@ -197,3 +197,37 @@ TEST(ColourClassesTest, RedHueWrapsAroundZero) {
 
 }  // namespace
 }  // namespace slamo::vision
+
+namespace slamo::vision {
+namespace {
+
+// The season's landmark markers on the far wall: found in their colours, at their range.
+TEST(LandmarkDetectionTest, FindsTheMarkersOnTheFarWall) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  platform::SimWorld world = platform::CreateWorld(season, 1);
+  world.objects.clear();
+  platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 1);
+  platform::FrameTruth truth;
+  const platform::Pose2D pose{0.0, 0.0, 0.0};
+  const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, &truth);
+  const DetectorSetup setup = LandmarkDetectorSetup(season, &robot.camera);
+  const std::vector<Detection> found = Detect(frame.colour, frame.depth_mm, setup, {});
+  int matched = 0;
+  for (const platform::LandmarkTruth& l : truth.landmarks) {
+    if (l.pixels < 60) continue;  // barely in view
+    const Eigen::Vector2d expected(std::hypot(l.position_m.x(), l.position_m.y()),
+                                   std::atan2(l.position_m.y(), l.position_m.x()));
+    for (const Detection& d : found) {
+      if (d.colour != season.landmarks[l.index].colour || !d.measurement) continue;
+      if (std::abs(d.measurement->bearing_rad - expected.y()) > 0.05) continue;
+      EXPECT_NEAR(d.measurement->range_m, expected.x(), 0.05);
+      ++matched;
+    }
+  }
+  EXPECT_GE(matched, 2);
+  EXPECT_LE(found.size(), truth.landmarks.size());  // nothing else taken for a marker
+}
+
+}  // namespace
+}  // namespace slamo::vision
