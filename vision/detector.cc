@@ -143,7 +143,7 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
     }
   }
   cv::Mat labels_small(small.size(), CV_32SC1, cv::Scalar(-1));
-    // Two clusters per colour (lit and shaded sides) plus a few spare, so neighbouring hues
+  // Two clusters per colour (lit and shaded sides) plus a few spare, so neighbouring hues
   // (red and orange) do not have to share one.
   const int k = 2 * static_cast<int>(setup.colours.size() + setup.distractors.size()) +
                 options.kmeans_extra_clusters;

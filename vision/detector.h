@@ -42,7 +42,7 @@ struct DetectOptions {
   // K-Means (thesis 5.2.2): clustering of the chromatic pixels in Lab a*b*.
   int kmeans_downsample = 0;           // cluster on an image this many times smaller; 0: about
                                        // 256 px wide (2x at 512x424, 8x at 1920x1080)
-    int kmeans_extra_clusters = 2;    // k = 2 x (colour classes + distractors) + this
+  int kmeans_extra_clusters = 2;       // k = 2 x (colour classes + distractors) + this
   double kmeans_min_chroma = 10.0;     // pixels greyer than this (a*b* radius) are not clustered
   double kmeans_max_angle_deg = 25.0;  // a cluster joins the class nearest in a*b* hue angle
   int kmeans_iterations = 10;

@@ -23,7 +23,7 @@ const Scene& SceneAt(int width) {
   if (it != scenes.end()) return it->second;
   const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
   field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
-    if (width != robot.camera.width_px) {
+  if (width != robot.camera.width_px) {
     // The Kinect V2 colour camera: 1920x1080, square pixels, fx = fy ~ 1081 px.
     robot.camera.width_px = 1920, robot.camera.height_px = 1080;
     robot.camera.fx = robot.camera.fy = 1081.37;
