@@ -1,0 +1,279 @@
+#include "mapping/ekf_slam.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+
+namespace slamo::mapping {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double Wrap(double a) {
+  const double w = std::remainder(a, 2.0 * kPi);
+  return w <= -kPi ? w + 2.0 * kPi : w;
+}
+
+// Keeps P symmetric after every operation (round-off breaks it slowly otherwise).
+void Symmetrise(Eigen::MatrixXd* p) { *p = 0.5 * (*p + p->transpose()); }
+
+// The regularised lower incomplete gamma function P(a, x) (series below a + 1, continued
+// fraction above; Numerical Recipes 6.2), the chi-square CDF being P(dof / 2, x / 2).
+double RegularisedGammaP(double a, double x) {
+  if (x <= 0.0) return 0.0;
+  const double log_prefix = -x + a * std::log(x) - std::lgamma(a);
+  if (x < a + 1.0) {
+    double term = 1.0 / a, sum = term;
+    for (int n = 1; n < 1000 && std::abs(term) > 1e-15 * std::abs(sum); ++n) {
+      term *= x / (a + n);
+      sum += term;
+    }
+    return sum * std::exp(log_prefix);
+  }
+  double b = x + 1.0 - a, c = 1e300, d = 1.0 / b, h = d;
+  for (int i = 1; i < 1000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < 1e-300) d = 1e-300;
+    c = b + an / c;
+    if (std::abs(c) < 1e-300) c = 1e-300;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::abs(delta - 1.0) < 1e-15) break;
+  }
+  return 1.0 - std::exp(log_prefix) * h;
+}
+
+// The p-quantile of chi-square with `dof` degrees of freedom, by bisection on its CDF.
+double Chi2Quantile(double p, int dof) {
+  double lo = 0.0, hi = std::max(10.0, 5.0 * dof);
+  while (RegularisedGammaP(dof / 2.0, hi / 2.0) < p) hi *= 2.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (RegularisedGammaP(dof / 2.0, mid / 2.0) < p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+EkfSlam::EkfSlam(const Eigen::Vector3d& start_pose, const Eigen::Matrix3d& start_covariance,
+                 const EkfOptions& options)
+    : options_(options), x_(start_pose), p_(start_covariance) {}
+
+Eigen::Vector3d EkfSlam::Move(const Eigen::Vector3d& pose, const OdometryStep& u,
+                              Eigen::Matrix3d* f_pose, Eigen::Matrix3d* f_u) {
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  const Eigen::Vector3d next(pose.x() + c * u.dx_m - s * u.dy_m, pose.y() + s * u.dx_m + c * u.dy_m,
+                             Wrap(pose.z() + u.dtheta_rad));
+  if (f_pose) {
+    *f_pose << 1, 0, -s * u.dx_m - c * u.dy_m,  //
+        0, 1, c * u.dx_m - s * u.dy_m,          //
+        0, 0, 1;
+  }
+  if (f_u) {
+    *f_u << c, -s, 0,  //
+        s, c, 0,       //
+        0, 0, 1;
+  }
+  return next;
+}
+
+Eigen::Matrix3d EkfSlam::MotionCovariance(const OdometryStep& u) const {
+  const MotionNoise& m = options_.motion;
+  const double distance = std::hypot(u.dx_m, u.dy_m);
+  const double turn = std::abs(u.dtheta_rad);
+  const double sx = m.sigma_per_m * distance + m.floor_m;
+  const double sy = m.lateral_sigma_per_m * distance + m.lateral_sigma_per_rad * turn + m.floor_m;
+  const double st = m.heading_sigma_per_rad * turn + m.heading_sigma_per_m * distance + m.floor_rad;
+  return Eigen::Vector3d(sx * sx, sy * sy, st * st).asDiagonal();
+}
+
+void EkfSlam::Predict(const OdometryStep& u) {
+  Eigen::Matrix3d f_pose, f_u;
+  x_.head<3>() = Move(x_.head<3>(), u, &f_pose, &f_u);
+  // P = F P F^T + G Q G^T, touching only the pose rows and columns.
+  const int n = static_cast<int>(x_.size());
+  p_.topLeftCorner<3, 3>() = f_pose * p_.topLeftCorner<3, 3>() * f_pose.transpose() +
+                             f_u * MotionCovariance(u) * f_u.transpose();
+  if (n > 3) {
+    p_.topRightCorner(3, n - 3) = f_pose * p_.topRightCorner(3, n - 3);
+    p_.bottomLeftCorner(n - 3, 3) = p_.topRightCorner(3, n - 3).transpose();
+  }
+  Symmetrise(&p_);
+}
+
+Eigen::Vector2d EkfSlam::Observe(const Eigen::Vector3d& pose, const Eigen::Vector2d& landmark) {
+  const Eigen::Vector2d d = landmark - pose.head<2>();
+  return Eigen::Vector2d(d.norm(), Wrap(std::atan2(d.y(), d.x()) - pose.z()));
+}
+
+void EkfSlam::ObserveJacobians(const Eigen::Vector3d& pose, const Eigen::Vector2d& landmark,
+                               Eigen::Matrix<double, 2, 3>* h_pose, Eigen::Matrix2d* h_landmark) {
+  const Eigen::Vector2d d = landmark - pose.head<2>();
+  const double q = d.squaredNorm();
+  const double r = std::sqrt(q);
+  *h_landmark << d.x() / r, d.y() / r,  //
+      -d.y() / q, d.x() / q;
+  h_pose->leftCols<2>() = -*h_landmark;
+  h_pose->col(2) = Eigen::Vector2d(0.0, -1.0);
+}
+
+Eigen::Vector2d EkfSlam::InverseObserve(const Eigen::Vector3d& pose, double range_m,
+                                        double bearing_rad, Eigen::Matrix<double, 2, 3>* g_pose,
+                                        Eigen::Matrix2d* g_z) {
+  const double a = pose.z() + bearing_rad;
+  const double c = std::cos(a), s = std::sin(a);
+  if (g_pose) {
+    *g_pose << 1, 0, -range_m * s,  //
+        0, 1, range_m * c;
+  }
+  if (g_z) {
+    *g_z << c, -range_m * s,  //
+        s, range_m * c;
+  }
+  return Eigen::Vector2d(pose.x() + range_m * c, pose.y() + range_m * s);
+}
+
+double EkfSlam::Mahalanobis2(const RangeBearing& z, int index) const {
+  const Eigen::Vector3d pose = x_.head<3>();
+  const Eigen::Vector2d l = landmark(index);
+  Eigen::Matrix<double, 2, 3> h_pose;
+  Eigen::Matrix2d h_l;
+  ObserveJacobians(pose, l, &h_pose, &h_l);
+  const int j = 3 + 2 * index;
+  const Eigen::Matrix2d s = h_pose * p_.topLeftCorner<3, 3>() * h_pose.transpose() +
+                            h_pose * p_.block<3, 2>(0, j) * h_l.transpose() +
+                            h_l * p_.block<2, 3>(j, 0) * h_pose.transpose() +
+                            h_l * p_.block<2, 2>(j, j) * h_l.transpose() + z.covariance;
+  Eigen::Vector2d e = Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(pose, l);
+  e.y() = Wrap(e.y());
+  return e.dot(s.ldlt().solve(e));
+}
+
+void EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
+  const int n = static_cast<int>(x_.size());
+  const int j = 3 + 2 * index;
+  Eigen::Matrix<double, 2, 3> h_pose;
+  Eigen::Matrix2d h_l;
+  ObserveJacobians(x_.head<3>(), landmark(index), &h_pose, &h_l);
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2, n);
+  h.leftCols<3>() = h_pose;
+  h.block<2, 2>(0, j) = h_l;
+  // Only the pose and this landmark's columns of H are non-zero: P H^T from those.
+  const Eigen::MatrixXd pht =
+      p_.leftCols<3>() * h_pose.transpose() + p_.middleCols<2>(j) * h_l.transpose();
+  const Eigen::Matrix2d s =
+      h.middleCols<3>(0) * pht.topRows<3>() + h_l * pht.middleRows<2>(j) + z.covariance;
+  const Eigen::MatrixXd k = pht * s.inverse();
+  Eigen::Vector2d e =
+      Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(x_.head<3>(), landmark(index));
+  e.y() = Wrap(e.y());
+  x_ += k * e;
+  x_(2) = Wrap(x_(2));
+  // Joseph form: P = (I - K H) P (I - K H)^T + K R K^T.
+  Eigen::MatrixXd ikh = -k * h;
+  ikh.diagonal().array() += 1.0;
+  p_ = ikh * p_ * ikh.transpose() + k * z.covariance * k.transpose();
+  Symmetrise(&p_);
+}
+
+int EkfSlam::AddLandmark(const RangeBearing& z) {
+  const int n = static_cast<int>(x_.size());
+  Eigen::Matrix<double, 2, 3> g_pose;
+  Eigen::Matrix2d g_z;
+  const Eigen::Vector2d l = InverseObserve(x_.head<3>(), z.range_m, z.bearing_rad, &g_pose, &g_z);
+  x_.conservativeResize(n + 2);
+  x_.tail<2>() = l;
+  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(n + 2, n + 2);
+  grown.topLeftCorner(n, n) = p_;
+  // Cross-covariances with everything the pose is correlated with.
+  grown.block(n, 0, 2, n) = g_pose * p_.topRows<3>();
+  grown.block(0, n, n, 2) = grown.block(n, 0, 2, n).transpose();
+  grown.block<2, 2>(n, n) =
+      g_pose * p_.topLeftCorner<3, 3>() * g_pose.transpose() + g_z * z.covariance * g_z.transpose();
+  p_ = std::move(grown);
+  Symmetrise(&p_);
+  ids_.push_back(z.id);
+  signatures_.push_back(z.signature);
+  return static_cast<int>(ids_.size()) - 1;
+}
+
+void EkfSlam::AddKnownLandmark(const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance,
+                               int id, const std::string& signature) {
+  const int n = static_cast<int>(x_.size());
+  x_.conservativeResize(n + 2);
+  x_.tail<2>() = position;
+  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(n + 2, n + 2);
+  grown.topLeftCorner(n, n) = p_;
+  grown.block<2, 2>(n, n) = covariance;
+  p_ = std::move(grown);
+  ids_.push_back(id);
+  signatures_.push_back(signature);
+}
+
+UpdateOutcome EkfSlam::Update(const RangeBearing& z) {
+  if (!(z.range_m > 0.0) || z.range_m > options_.max_range_m || !std::isfinite(z.bearing_rad)) {
+    return UpdateOutcome::kRejected;
+  }
+  // Known id: that landmark, or a new one with that id.
+  if (z.id >= 0) {
+    for (int i = 0; i < landmark_count(); ++i) {
+      if (ids_[i] == z.id) {
+        if (Mahalanobis2(z, i) > options_.association.new_chi2) return UpdateOutcome::kRejected;
+        ApplyUpdate(z, i);
+        return UpdateOutcome::kUpdated;
+      }
+    }
+    AddLandmark(z);
+    return UpdateOutcome::kAdded;
+  }
+  // Nearest neighbour by Mahalanobis distance among same-signature landmarks.
+  int best = -1, candidates = 0;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < landmark_count(); ++i) {
+    if (signatures_[i] != z.signature) continue;
+    const double d2 = Mahalanobis2(z, i);
+    if (d2 < options_.association.gate_chi2) ++candidates;
+    if (d2 < best_d2) best_d2 = d2, best = i;
+  }
+  if (best >= 0 && best_d2 < options_.association.gate_chi2) {
+    if (candidates > 1) return UpdateOutcome::kAmbiguous;  // two within the gate: no guess
+    ApplyUpdate(z, best);
+    return UpdateOutcome::kUpdated;
+  }
+  if (best < 0 || best_d2 > options_.association.new_chi2) {
+    AddLandmark(z);
+    return UpdateOutcome::kAdded;
+  }
+  return UpdateOutcome::kRejected;  // between the gates: neither matched nor surely new
+}
+
+double PoseNees(const Eigen::Vector3d& truth, const Eigen::Vector3d& estimate,
+                const Eigen::Matrix3d& covariance) {
+  Eigen::Vector3d e = truth - estimate;
+  e.z() = Wrap(e.z());
+  return e.dot(covariance.ldlt().solve(e));
+}
+
+std::pair<double, double> NeesBand(int dof, int runs) {
+  const int k = dof * runs;
+  return {Chi2Quantile(0.025, k) / runs, Chi2Quantile(0.975, k) / runs};
+}
+
+Eigen::Matrix2d IteratedFrameCovariance(const Eigen::Matrix2d& white, const Eigen::Matrix2d& bias,
+                                        int frame_index) {
+  Eigen::Matrix2d r = Eigen::Matrix2d::Zero();
+  for (int c = 0; c < 2; ++c) {
+    const double w = white(c, c), b = bias(c, c);
+    const int k = std::max(1, frame_index);
+    r(c, c) = w > 0.0 ? (w + k * b) * (w + (k - 1) * b) / w : w + b;
+  }
+  return r;
+}
+
+}  // namespace slamo::mapping

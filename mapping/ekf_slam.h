@@ -1,0 +1,129 @@
+// EKF SLAM over the robot pose and point landmarks (thesis ch. 4, corrected): state
+// X = [x, y, theta, l1x, l1y, ...], prediction from encoder odometry with noise that grows
+// with distance and turn, range-bearing updates r = hypot(dx, dy), phi = atan2(dy, dx) - theta
+// in Joseph form, augmentation with the inverse observation model and its cross-covariances,
+// and data association by known id or by Mahalanobis nearest neighbour with one gate to
+// associate and a stricter one to create a landmark.
+//
+// Game objects are not in this state: they move (robots push them), and a moved object in the
+// joint state would drag the robot's pose. They are tracked apart, conditioned on the pose
+// (object_tracker.h).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace slamo::mapping {
+
+// Odometry increment in the robot frame at the start of the step.
+struct OdometryStep {
+  double dx_m = 0.0;  // forward
+  double dy_m = 0.0;  // left
+  double dtheta_rad = 0.0;
+};
+
+struct MotionNoise {
+  double sigma_per_m = 0.17;            // forward distance sigma per metre travelled
+  double lateral_sigma_per_m = 0.03;    // sideways sigma per metre travelled
+  double lateral_sigma_per_rad = 0.06;  // sideways sigma per radian turned (turn slip)
+  double heading_sigma_per_rad = 0.04;  // heading sigma per radian turned (~2 deg per 90)
+  double heading_sigma_per_m = 0.02;    // heading sigma per metre travelled
+  double floor_m = 1e-4;                // keeps Q positive definite when standing still
+  double floor_rad = 1e-4;
+};
+
+// One range-bearing measurement from the robot centre, with its covariance (vision's).
+struct RangeBearing {
+  double range_m = 0.0;
+  double bearing_rad = 0.0;
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity() * 1e-4;
+  int id = -1;            // known landmark id (>= 0) or -1 when it must be associated
+  std::string signature;  // e.g. the marker's colour: only same-signature landmarks match
+};
+
+struct AssociationOptions {
+  double gate_chi2 = 9.21;  // associate within this Mahalanobis distance^2 (99 %, 2 dof)
+  double new_chi2 = 25.0;   // create a landmark only beyond this from every landmark
+};
+
+struct EkfOptions {
+  MotionNoise motion;
+  AssociationOptions association;
+  double max_range_m = 4.5;  // measurements beyond this are ignored
+};
+
+// What an update did with each measurement.
+enum class UpdateOutcome { kUpdated, kAdded, kAmbiguous, kRejected };
+
+class EkfSlam {
+ public:
+  EkfSlam(const Eigen::Vector3d& start_pose, const Eigen::Matrix3d& start_covariance,
+          const EkfOptions& options = {});
+
+  // Prediction: X- = f(X+, u), P- = F P F^T + G Q G^T.
+  void Predict(const OdometryStep& u);
+  // Update with one measurement (associating it, or adding a landmark).
+  UpdateOutcome Update(const RangeBearing& z);
+
+  const Eigen::VectorXd& state() const { return x_; }
+  const Eigen::MatrixXd& covariance() const { return p_; }
+  Eigen::Vector3d pose() const { return x_.head<3>(); }
+  Eigen::Matrix3d pose_covariance() const { return p_.topLeftCorner<3, 3>(); }
+  int landmark_count() const { return static_cast<int>(ids_.size()); }
+  Eigen::Vector2d landmark(int index) const { return x_.segment<2>(3 + 2 * index); }
+  Eigen::Matrix2d landmark_covariance(int index) const {
+    return p_.block<2, 2>(3 + 2 * index, 3 + 2 * index);
+  }
+  int landmark_id(int index) const { return ids_[index]; }
+  const std::string& landmark_signature(int index) const { return signatures_[index]; }
+  // Inserts a landmark known in advance (a surveyed field), with its covariance.
+  void AddKnownLandmark(const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance, int id,
+                        const std::string& signature);
+
+  // The measurement model and its Jacobians (public for tests).
+  static Eigen::Vector2d Observe(const Eigen::Vector3d& pose, const Eigen::Vector2d& landmark);
+  // d h / d pose (2x3) and d h / d landmark (2x2).
+  static void ObserveJacobians(const Eigen::Vector3d& pose, const Eigen::Vector2d& landmark,
+                               Eigen::Matrix<double, 2, 3>* h_pose, Eigen::Matrix2d* h_landmark);
+  // Inverse model: landmark from pose and measurement, with d g / d pose and d g / d z.
+  static Eigen::Vector2d InverseObserve(const Eigen::Vector3d& pose, double range_m,
+                                        double bearing_rad, Eigen::Matrix<double, 2, 3>* g_pose,
+                                        Eigen::Matrix2d* g_z);
+  // Motion model with d f / d pose (3x3) and d f / d u (3x3).
+  static Eigen::Vector3d Move(const Eigen::Vector3d& pose, const OdometryStep& u,
+                              Eigen::Matrix3d* f_pose, Eigen::Matrix3d* f_u);
+  Eigen::Matrix3d MotionCovariance(const OdometryStep& u) const;
+
+  // Mahalanobis distance^2 of a measurement to landmark `index` (innovation covariance S).
+  double Mahalanobis2(const RangeBearing& z, int index) const;
+
+ private:
+  void ApplyUpdate(const RangeBearing& z, int index);
+  int AddLandmark(const RangeBearing& z);
+
+  EkfOptions options_;
+  Eigen::VectorXd x_;
+  Eigen::MatrixXd p_;
+  std::vector<int> ids_;
+  std::vector<std::string> signatures_;
+};
+
+// Pose NEES (x - x_hat)^T P^-1 (x - x_hat), heading error wrapped.
+double PoseNees(const Eigen::Vector3d& truth, const Eigen::Vector3d& estimate,
+                const Eigen::Matrix3d& covariance);
+
+// Two-sided 95 % band of the average NEES of `runs` runs of a `dof`-dimensional state:
+// [chi2_{0.025}(dof * runs), chi2_{0.975}(dof * runs)] / runs.
+std::pair<double, double> NeesBand(int dof, int runs);
+
+// Repeated frames of a static scene share an error that does not average away (a per-stop
+// bias): with white variance w and bias variance b per component, the k-th frame's update
+// uses R_k = (w + k b)(w + (k - 1) b) / w, so that k sequential updates carry exactly the
+// information of their average, 1 / (w / k + b).
+Eigen::Matrix2d IteratedFrameCovariance(const Eigen::Matrix2d& white, const Eigen::Matrix2d& bias,
+                                        int frame_index /* 1-based */);
+
+}  // namespace slamo::mapping
