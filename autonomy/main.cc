@@ -19,7 +19,9 @@ int main(int argc, char** argv) {
       "  slamo sim drive --script \"forward 0.3; turn 90\"   encoder drift against the truth\n"
       "  slamo calibrate plane --depth DIR/depth.png   camera-to-wall distance (RANSAC plane)\n"
       "  slamo detect --color DIR/colour.png --depth DIR/depth.png --out seen.png\n"
-      "  slamo eval vision --frames 50             detection methods against ground truth");
+      "  slamo eval vision --frames 50             detection methods against ground truth\n"
+      "  slamo replay --log run.log --truth t.tum --out DIR   EKF SLAM over a log; ATE\n"
+      "  slamo map build --out DIR                 the OctoMap: map.bt, map.ot, grid.png");
 
   slamo::autonomy::CommandAction action;
   slamo::autonomy::RegisterFieldCommand(app, &action);
@@ -27,6 +29,8 @@ int main(int argc, char** argv) {
   slamo::autonomy::RegisterCalibrateCommand(app, &action);
   slamo::autonomy::RegisterDetectCommand(app, &action);
   slamo::autonomy::RegisterEvalCommand(app, &action);
+  slamo::autonomy::RegisterReplayCommand(app, &action);
+  slamo::autonomy::RegisterMapCommand(app, &action);
 
   try {
     app.parse(argc, argv);

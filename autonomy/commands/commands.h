@@ -26,4 +26,10 @@ void RegisterDetectCommand(CLI::App& app, CommandAction* action);
 // `slamo eval vision`.
 void RegisterEvalCommand(CLI::App& app, CommandAction* action);
 
+// `slamo replay`: EKF SLAM over a recorded run, scored against ground truth.
+void RegisterReplayCommand(CLI::App& app, CommandAction* action);
+
+// `slamo map build`.
+void RegisterMapCommand(CLI::App& app, CommandAction* action);
+
 }  // namespace slamo::autonomy

@@ -1,0 +1,93 @@
+// Accuracy of a SLAM run against ground truth: trajectories in the TUM RGB-D format, the
+// absolute trajectory error (ATE) exactly as the TUM RGB-D benchmark's evaluate_ate.py computes
+// it (associate by timestamp, rigid Horn/Umeyama alignment without scale, RMSE of the
+// translational differences), and the landmark position error after the same alignment.
+// Pure functions apart from the file readers and writers; bad files throw std::runtime_error
+// naming the file and the line.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace slamo::mapping {
+
+// A planar pose at a time.
+struct TimedPose {
+  double t_s = 0.0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double theta_rad = 0.0;
+};
+
+// A point landmark with its id (-1 when it has none).
+struct LandmarkPoint {
+  int id = -1;
+  double x_m = 0.0;
+  double y_m = 0.0;
+};
+
+// A planar rigid transform p' = R(theta) p + t.
+struct Rigid2d {
+  double theta_rad = 0.0;
+  Eigen::Vector2d translation_m = Eigen::Vector2d::Zero();
+
+  Eigen::Vector2d Apply(const Eigen::Vector2d& p) const;
+  TimedPose Apply(const TimedPose& pose) const;
+};
+
+// TUM RGB-D trajectory: one line `timestamp tx ty tz qx qy qz qw` per pose, z = 0 and the
+// quaternion a rotation about z by theta. Throws std::runtime_error if the file cannot be
+// written.
+void WriteTumTrajectory(const std::string& path, const std::vector<TimedPose>& poses);
+// Reads a TUM trajectory (`#` comments and blank lines allowed); the heading is the yaw of the
+// quaternion. Errors name the file and the line.
+std::vector<TimedPose> ReadTumTrajectory(const std::string& path);
+
+// Pairs (truth index, estimate index) whose timestamps differ by less than max_dt_s, each
+// timestamp used at most once, closest pairs first (the benchmark's associate.py with offset
+// 0); sorted by truth time.
+std::vector<std::pair<int, int>> AssociateByTime(const std::vector<TimedPose>& truth,
+                                                 const std::vector<TimedPose>& estimate,
+                                                 double max_dt_s);
+
+// The rigid transform (no scale) that best maps `from` onto `to` in the least-squares sense
+// (Horn / Umeyama). Needs at least one pair; with one pair it is a translation.
+Rigid2d AlignRigid(const std::vector<Eigen::Vector2d>& from,
+                   const std::vector<Eigen::Vector2d>& to);
+
+struct AteResult {
+  double rmse_m = 0.0;  // the ATE
+  double mean_m = 0.0;
+  double median_m = 0.0;
+  double max_m = 0.0;
+  int pairs = 0;      // associated poses
+  Rigid2d alignment;  // estimate -> truth frame (identity without alignment)
+};
+
+// Absolute trajectory error of `estimate` against `truth`. Throws std::invalid_argument when
+// no timestamps associate.
+AteResult AbsoluteTrajectoryError(const std::vector<TimedPose>& truth,
+                                  const std::vector<TimedPose>& estimate, double max_dt_s = 0.02,
+                                  bool align = true);
+
+struct LandmarkError {
+  double rmse_m = 0.0;
+  int pairs = 0;    // matched landmarks
+  int missing = 0;  // truth landmarks without an estimate
+};
+
+// RMSE of estimated landmark positions, mapped into the truth frame by `alignment` (e.g.
+// AteResult::alignment, so the map is judged in the frame that best fits the trajectory).
+// Landmarks match by id; an estimate without an id (-1) matches the nearest truth landmark not
+// otherwise matched. Throws std::invalid_argument when nothing matches.
+LandmarkError LandmarkRmse(const std::vector<LandmarkPoint>& truth,
+                           const std::vector<LandmarkPoint>& estimate,
+                           const Rigid2d& alignment = {});
+
+// Landmark CSV: an optional header line, then `id,x_m,y_m[,more columns]` per landmark (the replay
+// command's landmarks.csv has the covariance in the extra columns). Errors name file and line.
+std::vector<LandmarkPoint> ReadLandmarkCsv(const std::string& path);
+
+}  // namespace slamo::mapping
