@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   slamo::autonomy::RegisterDetectCommand(app, &action);
   slamo::autonomy::RegisterEvalCommand(app, &action);
   slamo::autonomy::RegisterReplayCommand(app, &action);
+  slamo::autonomy::RegisterExperimentCommand(app, &action);
   slamo::autonomy::RegisterMapCommand(app, &action);
 
   try {

@@ -87,7 +87,7 @@ Eigen::Matrix3d EkfSlam::MotionCovariance(const OdometryStep& u) const {
   const MotionNoise& m = options_.motion;
   const double distance = std::hypot(u.dx_m, u.dy_m);
   const double turn = std::abs(u.dtheta_rad);
-  const double sx = m.sigma_per_m * distance + m.floor_m;
+  const double sx = m.sigma_per_m * distance + m.forward_sigma_per_rad * turn + m.floor_m;
   const double sy = m.lateral_sigma_per_m * distance + m.lateral_sigma_per_rad * turn + m.floor_m;
   const double st = m.heading_sigma_per_rad * turn + m.heading_sigma_per_m * distance + m.floor_rad;
   return Eigen::Vector3d(sx * sx, sy * sy, st * st).asDiagonal();

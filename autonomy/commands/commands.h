@@ -29,6 +29,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action);
 // `slamo replay`: EKF SLAM over a recorded run, scored against ground truth.
 void RegisterReplayCommand(CLI::App& app, CommandAction* action);
 
+// `slamo experiment waypoints|nees`.
+void RegisterExperimentCommand(CLI::App& app, CommandAction* action);
+
 // `slamo map build`.
 void RegisterMapCommand(CLI::App& app, CommandAction* action);
 
