@@ -235,8 +235,11 @@ DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
       k.radius_m = type.size_m / 2.0;
       const bool round =
           type.shape == field::ObjectShape::kSphere || type.shape == field::ObjectShape::kTriball;
+      // The measured depth is the median over the visible cap of a ball, which lies about
+      // r / sqrt(2) in front of its centre (the median of sqrt(1 - rho^2) over a disc); a flat
+      // face lies half the smaller extent in front of the centre.
       k.surface_to_centre_m =
-          round ? type.size_m / 2.0 : std::min(type.size_m, type.height_m) / 2.0;
+          round ? type.size_m / 2.0 / std::sqrt(2.0) : std::min(type.size_m, type.height_m) / 2.0;
       // Round things look round from anywhere; cubes are squares (0.785), rings, stars and
       // blocks seen from a low camera are flat shapes.
       k.min_circularity = round ? 0.6 : 0.3;
