@@ -188,6 +188,7 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
   for (const mapping::TrackedObject& o : tracker.objects()) {
     WaypointsRun::ObjectResult r;
     r.tracked = o;
+    r.confirmed = tracker.Confirmed(o);
     r.first_range_m = first_range[o.id];
     double best = 0.5;
     for (size_t k = 0; k < sim.world().objects.size(); ++k) {

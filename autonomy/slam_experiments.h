@@ -53,6 +53,7 @@ struct WaypointsRun {
     double error_m = 0.0;
     double first_range_m = 0.0;  // from the robot when first seen
     bool truth_moved = false;    // the true object was pushed during the run
+    bool confirmed = false;      // seen at least twice (the tracker's rule)
   };
   std::vector<ObjectResult> objects;
   double AccumulatedError() const;

@@ -41,6 +41,7 @@ struct ObjectTrackerOptions {
   double missed_confidence_loss = 0.25;  // per frame in which it should have been seen
   double drop_confidence = 0.15;         // below this the object is forgotten
   double motion_sigma_per_s = 0.0;       // objects are static unless pushed (m per sqrt(s))
+  int confirm_sightings = 2;             // an object is confirmed (mapped) once seen this often
 };
 
 class ObjectTracker {
@@ -56,6 +57,10 @@ class ObjectTracker {
               const std::function<bool(const Eigen::Vector2d&)>& expected_visible = {});
 
   const std::vector<TrackedObject>& objects() const { return objects_; }
+  // Seen at least confirm_sightings times: a single sighting may be a false detection.
+  bool Confirmed(const TrackedObject& object) const {
+    return object.times_seen >= options_.confirm_sightings;
+  }
 
  private:
   ObjectTrackerOptions options_;
