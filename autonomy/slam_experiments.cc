@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "mapping/object_map.h"
 #include "platform/drive_script.h"
 #include "platform/sim_field.h"
 #include "platform/sim_renderer.h"
@@ -96,6 +97,7 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
     }
   }
   mapping::ObjectTracker tracker;
+  mapping::ObjectMap object_map(field);
   std::map<int, double> first_range;
   const std::vector<platform::SimObject> initial_objects = sim.world().objects;
   platform::SimClock clock;
@@ -172,9 +174,17 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
                        const Eigen::Vector2d z = mapping::EkfSlam::Observe(pose, p);
                        return z.x() > 0.8 && z.x() < 3.5 && std::abs(z.y()) < half_fov;
                      });
+      // The confirmed objects go into the OctoMap (objects that vanished leave it).
+      std::vector<mapping::MappedObject> mapped;
       for (const mapping::TrackedObject& o : tracker.objects()) {
         if (!first_range.count(o.id)) first_range[o.id] = (o.position_m - pose.head<2>()).norm();
+        const field::ObjectType* type = field.FindObjectType(o.kind);
+        if (!tracker.Confirmed(o) || !type) continue;
+        mapped.push_back({o.id, o.kind, o.colour,
+                          Eigen::Vector3d(o.position_m.x(), o.position_m.y(), type->height_m / 2.0),
+                          type->size_m / 2.0, type->height_m, o.confidence});
       }
+      object_map.SetObjects(mapped);
     }
     run.errors_by_stop.push_back(errors);
     const Eigen::Vector3d estimate = ekf.pose();
@@ -183,6 +193,10 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
     run.stop_error_m.push_back(std::hypot(estimate.x() - truth.x_m, estimate.y() - truth.y_m));
     run.odometry_error_m.push_back((odometry_in_field - truth_v.head<2>()).norm());
     run.stop_nees.push_back(mapping::PoseNees(truth_v, estimate, ekf.pose_covariance()));
+  }
+  if (objects && !setup.map_out_dir.empty()) {
+    object_map.WriteBinary(setup.map_out_dir + "/objects.bt");
+    object_map.WriteColored(setup.map_out_dir + "/objects.ot");
   }
   // Score the tracked objects against where the objects really are now.
   for (const mapping::TrackedObject& o : tracker.objects()) {

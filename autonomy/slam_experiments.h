@@ -29,6 +29,9 @@ struct WaypointsSetup {
   // Per-frame (white) measurement covariance; zero: vision's own estimate for each detection.
   Eigen::Matrix2d white_covariance = Eigen::Matrix2d::Zero();
   double known_landmark_sigma_m = 0.003;  // surveyed marker positions
+  // When set (and objects are tracked): the OctoMap of the field with the confirmed objects,
+  // updated at every stop, is written here at the end as objects.bt and objects.ot.
+  std::string map_out_dir;
   bool iterate = true;  // false: one update per stop whatever the rule (single-frame mode)
   // true: the markers' surveyed positions are given to the filter (sigma 1 cm), as a team
   // that placed them would; false: SLAM, they are found as the thesis did.

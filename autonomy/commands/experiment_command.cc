@@ -1,6 +1,7 @@
 // `slamo experiment`: the thesis's SLAM experiments on the simulated field, averaged over
 // seeds and printed as tables.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -20,6 +21,7 @@ struct ExperimentArgs {
   uint64_t seed = 1;
   std::string landmarks = "1,2,3";
   std::string map = "slam,known";
+  std::string out;  // case study: where to write the first run's object map
   std::string rules = "fixed:1,fixed:5,fixed:10,fixed:20,fixed:30,covariance,covariance:0.004,gmm";
 };
 
@@ -201,6 +203,7 @@ int RunCaseStudy(const ExperimentArgs& args, int study) {
     legs.push_back("forward 0.3");
     legs.push_back("forward 0.3");
   }
+  if (!args.out.empty()) std::filesystem::create_directories(args.out);
   WaypointsSetup setup;
   mapping::ParseFrameRule(args.rules.find(',') == std::string::npos ? args.rules : "fixed:20",
                           &setup.frames);
@@ -215,6 +218,7 @@ int RunCaseStudy(const ExperimentArgs& args, int study) {
   double within3_sq = 0.0, all_sq = 0.0;
   int within3 = 0, matched = 0, tracked = 0, moved = 0, unconfirmed = 0;
   for (int r = 0; r < args.runs; ++r) {
+    setup.map_out_dir = r == 0 ? args.out : "";
     const WaypointsRun run = RunRoute(season, robot, start, legs, setup, args.seed + r, true);
     for (size_t s = 0; s < legs.size(); ++s) {
       pose_error[s] += run.stop_error_m[s] / args.runs;
@@ -348,6 +352,8 @@ void RegisterExperimentCommand(CLI::App& app, CommandAction* action) {
       ->capture_default_str();
   case_study->add_option("--frames", args->rules,
                          "one frame rule (default fixed:20 as the thesis)");
+  case_study->add_option("--out", args->out,
+                         "write the first run's OctoMap (objects.bt, objects.ot) here");
   case_study->callback(
       [action, args, study] { *action = [args, study] { return RunCaseStudy(*args, *study); }; });
 
