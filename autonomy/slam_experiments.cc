@@ -127,6 +127,7 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
     for (int frame = 1;; ++frame) {
       rgbd = renderer.Render(sim.world(), truth, clock.NowS(), nullptr);
       const auto t0 = std::chrono::steady_clock::now();
+      std::vector<mapping::RangeBearing> measurements;
       for (const vision::Detection& d : vision::Detect(rgbd.colour, rgbd.depth_mm, detector, {})) {
         if (!d.measurement) continue;
         int index = -1;
@@ -143,7 +144,7 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
                                                         setup.iterate ? frame : 1);
         z.id = marker_id[index];
         z.signature = d.colour;
-        ekf.Update(z);
+        measurements.push_back(z);
         // The measurement's error against the truth (the marker as drawn), where the marker
         // is known by its colour.
         if (z.id >= 0) {
@@ -153,6 +154,8 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
                               platform::WrapAngleRad(z.bearing_rad - expected.y()));
         }
       }
+      // One frame's markers together: JCBB pairs those not known by their colour.
+      ekf.UpdateFrame(measurements);
       run.compute_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ++run.frames;
       clock.Advance(1.0 / robot.camera.frame_rate_hz);

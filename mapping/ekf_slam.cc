@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include <Eigen/Dense>
@@ -251,6 +252,115 @@ UpdateOutcome EkfSlam::Update(const RangeBearing& z) {
     return UpdateOutcome::kAdded;
   }
   return UpdateOutcome::kRejected;  // between the gates: neither matched nor surely new
+}
+
+std::vector<int> EkfSlam::JointCompatibility(const std::vector<RangeBearing>& frame) const {
+  const int m = static_cast<int>(frame.size());
+  const int n = landmark_count();
+  // Individually compatible candidates per measurement (same signature, inside the gate).
+  std::vector<std::vector<int>> candidates(m);
+  for (int i = 0; i < m; ++i) {
+    if (frame[i].id >= 0) continue;
+    for (int j = 0; j < n; ++j) {
+      if (signatures_[j] == frame[i].signature &&
+          Mahalanobis2(frame[i], j) < options_.association.gate_chi2) {
+        candidates[i].push_back(j);
+      }
+    }
+  }
+  // Joint Mahalanobis distance of a hypothesis (pairs measurement -> landmark).
+  const Eigen::Vector3d pose = x_.head<3>();
+  const int size = static_cast<int>(x_.size());
+  const auto joint_d2 = [&](const std::vector<std::pair<int, int>>& pairs) {
+    const int k = static_cast<int>(pairs.size());
+    Eigen::VectorXd e(2 * k);
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2 * k, size);
+    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(2 * k, 2 * k);
+    for (int p = 0; p < k; ++p) {
+      const auto [i, j] = pairs[p];
+      Eigen::Matrix<double, 2, 3> h_pose;
+      Eigen::Matrix2d h_l;
+      ObserveJacobians(pose, landmark(j), &h_pose, &h_l);
+      h.block<2, 3>(2 * p, 0) = h_pose;
+      h.block<2, 2>(2 * p, 3 + 2 * j) = h_l;
+      Eigen::Vector2d d =
+          Eigen::Vector2d(frame[i].range_m, frame[i].bearing_rad) - Observe(pose, landmark(j));
+      d.y() = Wrap(d.y());
+      e.segment<2>(2 * p) = d;
+      r.block<2, 2>(2 * p, 2 * p) = frame[i].covariance;
+    }
+    const Eigen::MatrixXd s = h * p_ * h.transpose() + r;
+    return e.dot(s.ldlt().solve(e));
+  };
+  // Depth-first branch and bound over the measurements.
+  std::vector<int> best(m, -1), current(m, -1);
+  int best_pairs = 0;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<bool> used(n, false);
+  const std::function<void(int)> search = [&](int i) {
+    if (i == m) {
+      const int k = static_cast<int>(pairs.size());
+      const double d2 = k ? joint_d2(pairs) : 0.0;
+      if (k > best_pairs || (k == best_pairs && d2 < best_d2))
+        best_pairs = k, best_d2 = d2, best = current;
+      return;
+    }
+    // Bound: even pairing every remaining measurement cannot beat the best.
+    int remaining = 0;
+    for (int r = i; r < m; ++r) remaining += !candidates[r].empty();
+    if (static_cast<int>(pairs.size()) + remaining < best_pairs) return;
+    for (int j : candidates[i]) {
+      if (used[j]) continue;
+      pairs.emplace_back(i, j);
+      // Joint compatibility at 99 % for 2k degrees of freedom.
+      if (joint_d2(pairs) < Chi2Quantile(0.99, 2 * static_cast<int>(pairs.size()))) {
+        used[j] = true;
+        current[i] = j;
+        search(i + 1);
+        current[i] = -1;
+        used[j] = false;
+      }
+      pairs.pop_back();
+    }
+    search(i + 1);  // this measurement unpaired
+  };
+  search(0);
+  return best;
+}
+
+std::vector<UpdateOutcome> EkfSlam::UpdateFrame(const std::vector<RangeBearing>& frame) {
+  std::vector<UpdateOutcome> out(frame.size(), UpdateOutcome::kRejected);
+  const std::vector<int> pairing = JointCompatibility(frame);
+  // Remember the landmarks before any update: indices stay valid (landmarks are appended).
+  std::vector<bool> add(frame.size(), false);
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const RangeBearing& z = frame[i];
+    if (!(z.range_m > 0.0) || z.range_m > options_.max_range_m || !std::isfinite(z.bearing_rad))
+      continue;
+    if (z.id >= 0) {
+      out[i] = Update(z);
+    } else if (pairing[i] >= 0) {
+      ApplyUpdate(z, pairing[i]);
+      out[i] = UpdateOutcome::kUpdated;
+    } else {
+      add[i] = true;
+    }
+  }
+  // Unpaired measurements: a new landmark only when far from every same-signature one.
+  for (size_t i = 0; i < frame.size(); ++i) {
+    if (!add[i]) continue;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < landmark_count(); ++j) {
+      if (signatures_[j] == frame[i].signature)
+        nearest = std::min(nearest, Mahalanobis2(frame[i], j));
+    }
+    if (nearest > options_.association.new_chi2) {
+      AddLandmark(frame[i]);
+      out[i] = UpdateOutcome::kAdded;
+    }
+  }
+  return out;
 }
 
 double PoseNees(const Eigen::Vector3d& truth, const Eigen::Vector3d& estimate,

@@ -72,6 +72,14 @@ class EkfSlam {
   void Predict(const OdometryStep& u);
   // Update with one measurement (associating it, or adding a landmark).
   UpdateOutcome Update(const RangeBearing& z);
+  // Update with one frame's measurements together: those without an id are associated by
+  // joint compatibility branch and bound (JCBB: the largest set of pairings whose joint
+  // innovation passes the chi-square gate, ties to the smallest joint Mahalanobis distance),
+  // which resolves what nearest neighbour cannot when same-coloured markers are close in
+  // view. Unpaired measurements beyond the creation gate become landmarks.
+  std::vector<UpdateOutcome> UpdateFrame(const std::vector<RangeBearing>& frame);
+  // The JCBB pairing of measurements (without ids) to landmark indices, -1 for none.
+  std::vector<int> JointCompatibility(const std::vector<RangeBearing>& frame) const;
 
   const Eigen::VectorXd& state() const { return x_; }
   const Eigen::MatrixXd& covariance() const { return p_; }

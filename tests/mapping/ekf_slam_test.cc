@@ -196,3 +196,52 @@ TEST(NeesBandTest, MatchesChiSquareTables) {
 
 }  // namespace
 }  // namespace slamo::mapping
+
+namespace slamo::mapping {
+namespace {
+
+// Two same-coloured markers 0.3 m apart and a robot unsure where it is: each measurement
+// alone fits both markers, so nearest neighbour refuses; jointly only one pairing fits.
+TEST(JcbbTest, ResolvesWhatNearestNeighbourCannot) {
+  const Eigen::Vector2d a(2.0, 0.15), b(2.0, -0.15);
+  const Eigen::Vector3d truth(0.0, 0.0, 0.0);
+  // The filter believes the robot 0.1 m to the left, with a wide covariance.
+  const Eigen::Vector3d belief(0.0, 0.1, 0.0);
+  const Eigen::Matrix3d belief_cov = Eigen::Vector3d(0.01, 0.04, 0.0025).asDiagonal();
+  const Eigen::Matrix2d r = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+  const auto make_filter = [&] {
+    EkfSlam ekf(belief, belief_cov);
+    ekf.AddKnownLandmark(a, Eigen::Matrix2d::Identity() * 1e-6, -1, "green");
+    ekf.AddKnownLandmark(b, Eigen::Matrix2d::Identity() * 1e-6, -1, "green");
+    return ekf;
+  };
+  std::vector<RangeBearing> frame;
+  for (const Eigen::Vector2d& l : {a, b}) {
+    const Eigen::Vector2d z = EkfSlam::Observe(truth, l);
+    frame.push_back({z.x(), z.y(), r, -1, "green"});
+  }
+  EkfSlam nn = make_filter();
+  EXPECT_EQ(nn.Update(frame[0]), UpdateOutcome::kAmbiguous);
+
+  EkfSlam jcbb = make_filter();
+  EXPECT_EQ(jcbb.JointCompatibility(frame), (std::vector<int>{0, 1}));
+  const std::vector<UpdateOutcome> outcomes = jcbb.UpdateFrame(frame);
+  EXPECT_EQ(outcomes,
+            (std::vector<UpdateOutcome>{UpdateOutcome::kUpdated, UpdateOutcome::kUpdated}));
+  EXPECT_EQ(jcbb.landmark_count(), 2);
+  EXPECT_LT((jcbb.pose().head<2>() - truth.head<2>()).norm(), 0.02);  // the belief is corrected
+}
+
+TEST(JcbbTest, UnpairedFarMeasurementsBecomeLandmarks) {
+  EkfSlam ekf(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-6);
+  const Eigen::Matrix2d r = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+  const auto outcomes = ekf.UpdateFrame({{2.0, 0.3, r, -1, "green"}, {2.0, -0.3, r, -1, "green"}});
+  EXPECT_EQ(outcomes, (std::vector<UpdateOutcome>{UpdateOutcome::kAdded, UpdateOutcome::kAdded}));
+  // The same frame again pairs with them.
+  const auto again = ekf.UpdateFrame({{2.001, 0.3, r, -1, "green"}, {1.999, -0.3, r, -1, "green"}});
+  EXPECT_EQ(again, (std::vector<UpdateOutcome>{UpdateOutcome::kUpdated, UpdateOutcome::kUpdated}));
+  EXPECT_EQ(ekf.landmark_count(), 2);
+}
+
+}  // namespace
+}  // namespace slamo::mapping
