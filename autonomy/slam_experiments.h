@@ -28,7 +28,7 @@ struct WaypointsSetup {
   Eigen::Matrix2d bias_covariance = Eigen::Matrix2d::Zero();  // per-stop measurement bias
   // Per-frame (white) measurement covariance; zero: vision's own estimate for each detection.
   Eigen::Matrix2d white_covariance = Eigen::Matrix2d::Zero();
-  double known_landmark_sigma_m = 0.003;  // surveyed marker positions
+  double known_landmark_sigma_m = 0.001;  // surveyed marker positions
   // When set (and objects are tracked): the OctoMap of the field with the confirmed objects,
   // updated at every stop, is written here at the end as objects.bt and objects.ot.
   std::string map_out_dir;

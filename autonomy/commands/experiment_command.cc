@@ -114,6 +114,7 @@ int RunWaypointsTable(const ExperimentArgs& args) {
         setup.landmarks = landmarks;
         setup.frames = rule;
         setup.bias_covariance = bias;
+        setup.white_covariance = white.asDiagonal();  // the measured per-frame noise
         setup.known_landmarks = known;
         double error = 0, odom = 0, frames = 0, compute = 0, nees = 0;
         int nees_n = 0;
