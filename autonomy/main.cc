@@ -21,7 +21,8 @@ int main(int argc, char** argv) {
       "  slamo detect --color DIR/colour.png --depth DIR/depth.png --out seen.png\n"
       "  slamo eval vision --frames 50             detection methods against ground truth\n"
       "  slamo replay --log run.log --truth t.tum --out DIR   EKF SLAM over a log; ATE\n"
-      "  slamo map build --out DIR                 the OctoMap: map.bt, map.ot, grid.png");
+      "  slamo map build --out DIR                 the OctoMap: map.bt, map.ot, grid.png\n"
+      "  slamo plan --no-objects --from -1.524,0.3048,0 --to 0.3,-1.2,90 --out plan.png   a path");
 
   slamo::autonomy::CommandAction action;
   slamo::autonomy::RegisterFieldCommand(app, &action);
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
   slamo::autonomy::RegisterReplayCommand(app, &action);
   slamo::autonomy::RegisterExperimentCommand(app, &action);
   slamo::autonomy::RegisterMapCommand(app, &action);
+  slamo::autonomy::RegisterPlanCommand(app, &action);
 
   try {
     app.parse(argc, argv);

@@ -35,4 +35,7 @@ void RegisterExperimentCommand(CLI::App& app, CommandAction* action);
 // `slamo map build`.
 void RegisterMapCommand(CLI::App& app, CommandAction* action);
 
+// `slamo plan`: an OMPL path across the field, its stops and travel time.
+void RegisterPlanCommand(CLI::App& app, CommandAction* action);
+
 }  // namespace slamo::autonomy
