@@ -1,10 +1,14 @@
 #include "planning/planner.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
+#include <ompl/base/MotionValidator.h>
 #include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/SimpleSetup.h>
@@ -48,13 +52,22 @@ ob::PlannerPtr MakePlanner(const std::string& name, const ob::SpaceInformationPt
                               "bitstar)");
 }
 
+// Length of the two segments meeting at q.
+double Corner(const Eigen::Vector2d& a, const Eigen::Vector2d& q, const Eigen::Vector2d& b) {
+  return (q - a).norm() + (b - q).norm();
+}
+
+bool Contains(const std::vector<int>& ids, int id) {
+  return std::find(ids.begin(), ids.end(), id) != ids.end();
+}
+
+}  // namespace
+
 double PathLength(const std::vector<Eigen::Vector2d>& path) {
   double length_m = 0.0;
   for (size_t i = 1; i < path.size(); ++i) length_m += (path[i] - path[i - 1]).norm();
   return length_m;
 }
-
-}  // namespace
 
 const std::vector<std::string>& PlannerNames() {
   static const std::vector<std::string> kNames = {"rrtconnect", "rrtstar", "informedrrtstar",
@@ -141,6 +154,20 @@ void Planner::SetMap(const mapping::ObjectMap& map) {
   SetGrid(map.ToGrid(options_.grid_cell_m, options_.grid_min_z_m, options_.grid_max_z_m));
 }
 
+void Planner::SetMap(const mapping::ObjectMap& map,
+                     const std::vector<mapping::MappedObject>& objects,
+                     const std::vector<int>& ignore_object_ids) {
+  std::vector<mapping::MappedObject> obstacles;
+  for (const mapping::MappedObject& o : objects) {
+    if (!Contains(ignore_object_ids, o.id) && !Contains(options_.ignore_object_ids, o.id)) {
+      obstacles.push_back(o);
+    }
+  }
+  mapping::ObjectMap without = map;  // unchanged objects cost nothing in SetObjects()
+  without.SetObjects(obstacles);
+  SetMap(without);
+}
+
 void Planner::SetGrid(const mapping::OccupancyGrid2D& grid) {
   grid_ = grid;
   // Distance (in cells, centre to centre) from every cell to the nearest occupied one.
@@ -169,6 +196,198 @@ bool Planner::IsClear(const Eigen::Vector2d& p_m) const {
   return index.has_value() && blocked_[*index] == 0;
 }
 
+double Planner::check_step_m() const {
+  return options_.check_resolution_m > 0 ? options_.check_resolution_m : grid_.cell_m / 4;
+}
+
+namespace {
+
+// OMPL's motion checks through Planner::SegmentIsClear().
+class GridMotionValidator : public ob::MotionValidator {
+ public:
+  GridMotionValidator(const ob::SpaceInformationPtr& si, const Planner& planner)
+      : ob::MotionValidator(si), planner_(planner) {}
+
+  bool checkMotion(const ob::State* s1, const ob::State* s2) const override {
+    const bool clear = planner_.SegmentIsClear(Point(s1), Point(s2));
+    clear ? ++valid_ : ++invalid_;
+    return clear;
+  }
+
+  // The last valid state: the last clear point every check step before the first blocked one.
+  bool checkMotion(const ob::State* s1, const ob::State* s2,
+                   std::pair<ob::State*, double>& last_valid) const override {
+    if (checkMotion(s1, s2)) return true;
+    const Eigen::Vector2d a = Point(s1), b = Point(s2);
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil((b - a).norm() / planner_.check_step_m())));
+    double t = 0.0;
+    for (int k = 1; k <= steps; ++k) {
+      const double next = static_cast<double>(k) / steps;
+      if (!planner_.SegmentIsClear(a, a + (b - a) * next)) break;
+      t = next;
+    }
+    if (last_valid.first != nullptr) si_->getStateSpace()->interpolate(s1, s2, t, last_valid.first);
+    last_valid.second = t;
+    return false;
+  }
+
+ private:
+  static Eigen::Vector2d Point(const ob::State* state) {
+    const auto* s = state->as<ob::RealVectorStateSpace::StateType>();
+    return {s->values[0], s->values[1]};
+  }
+
+  const Planner& planner_;
+};
+
+}  // namespace
+
+bool Planner::SegmentIsClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
+  if (options_.check_resolution_m > 0) {  // sampled
+    const double step_m = options_.check_resolution_m;
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step_m)));
+    for (int k = 0; k <= steps; ++k) {
+      if (!IsClear(a + (b - a) * (static_cast<double>(k) / steps))) return false;
+    }
+    return true;
+  }
+  // Exact: every cell the segment crosses (Amanatides and Woo's traversal), both side cells
+  // where it passes through a cell corner.
+  if (grid_.cells.empty()) return false;
+  auto blocked = [this](long col, long row) {
+    if (col < 0 || row < 0 || col >= grid_.width || row >= grid_.height) return true;
+    return blocked_[static_cast<size_t>(row) * grid_.width + static_cast<size_t>(col)] != 0;
+  };
+  const Eigen::Vector2d pa = (a - grid_.origin_m) / grid_.cell_m;
+  const Eigen::Vector2d pb = (b - grid_.origin_m) / grid_.cell_m;
+  long col = static_cast<long>(std::floor(pa.x())), row = static_cast<long>(std::floor(pa.y()));
+  const long end_col = static_cast<long>(std::floor(pb.x()));
+  const long end_row = static_cast<long>(std::floor(pb.y()));
+  if (blocked(col, row) || blocked(end_col, end_row)) return false;
+  const double dx = pb.x() - pa.x(), dy = pb.y() - pa.y();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const long step_col = dx > 0 ? 1 : -1, step_row = dy > 0 ? 1 : -1;
+  const double delta_x = dx != 0 ? 1.0 / std::abs(dx) : kInf;
+  const double delta_y = dy != 0 ? 1.0 / std::abs(dy) : kInf;
+  double next_x = dx > 0 ? (col + 1 - pa.x()) / dx : dx < 0 ? (pa.x() - col) / -dx : kInf;
+  double next_y = dy > 0 ? (row + 1 - pa.y()) / dy : dy < 0 ? (pa.y() - row) / -dy : kInf;
+  constexpr double kTie = 1e-12;
+  while (std::min(next_x, next_y) <= 1.0) {
+    if (next_x < next_y - kTie) {
+      col += step_col;
+      next_x += delta_x;
+    } else if (next_y < next_x - kTie) {
+      row += step_row;
+      next_y += delta_y;
+    } else {  // through a corner
+      if (blocked(col + step_col, row) || blocked(col, row + step_row)) return false;
+      col += step_col;
+      row += step_row;
+      next_x += delta_x;
+      next_y += delta_y;
+    }
+    if (blocked(col, row)) return false;
+  }
+  return true;
+}
+
+bool Planner::PathIsClear(const std::vector<Eigen::Vector2d>& path, size_t from_index) const {
+  if (from_index >= path.size()) return false;
+  if (!IsClear(path[from_index])) return false;
+  for (size_t i = from_index + 1; i < path.size(); ++i) {
+    if (!SegmentIsClear(path[i - 1], path[i])) return false;
+  }
+  return true;
+}
+
+std::vector<Eigen::Vector2d> Planner::Shorten(std::vector<Eigen::Vector2d> path,
+                                              int subdivisions) const {
+  if (path.size() < 3) return path;
+  // Drop vertices: from each kept vertex, jump to the farthest one in sight.
+  auto pull = [this](const std::vector<Eigen::Vector2d>& in) {
+    std::vector<Eigen::Vector2d> out = {in.front()};
+    size_t i = 0;
+    while (i + 1 < in.size()) {
+      size_t j = in.size() - 1;
+      while (j > i + 1 && !SegmentIsClear(in[i], in[j])) --j;
+      out.push_back(in[j]);
+      i = j;
+    }
+    return out;
+  };
+  // Slide each inner vertex (compass search, steps from two cells down to a millimetre)
+  // while the two segments through it get shorter and stay clear.
+  const double cell_m = grid_.cell_m > 0 ? grid_.cell_m : 0.02;
+  const double kDiag = std::sqrt(0.5);
+  const Eigen::Vector2d kDirections[8] = {{1, 0},          {-1, 0},         {0, 1},
+                                          {0, -1},         {kDiag, kDiag},  {kDiag, -kDiag},
+                                          {-kDiag, kDiag}, {-kDiag, -kDiag}};
+  auto slide = [&](std::vector<Eigen::Vector2d>& p) {
+    for (size_t i = 1; i + 1 < p.size(); ++i) {
+      const Eigen::Vector2d a = p[i - 1], b = p[i + 1];
+      for (double step_m = 2 * cell_m; step_m >= 0.001; step_m /= 2) {
+        for (int moves = 0; moves < 32; ++moves) {
+          bool moved = false;
+          const double current_m = Corner(a, p[i], b);
+          for (const Eigen::Vector2d& d : kDirections) {
+            const Eigen::Vector2d q = p[i] + step_m * d;
+            if (Corner(a, q, b) < current_m - 1e-9 && SegmentIsClear(a, q) &&
+                SegmentIsClear(q, b)) {
+              p[i] = q;
+              moved = true;
+              break;
+            }
+          }
+          if (!moved) break;
+        }
+      }
+    }
+  };
+  path = pull(path);
+  for (int level = 0; level <= subdivisions; ++level) {
+    if (level > 0) {  // a vertex between every two, so the path can bend round curves
+      std::vector<Eigen::Vector2d> finer = {path.front()};
+      for (size_t i = 1; i < path.size(); ++i) {
+        finer.push_back((path[i - 1] + path[i]) / 2);
+        finer.push_back(path[i]);
+      }
+      path = std::move(finer);
+    }
+    for (int round = 0; round < 4 && path.size() > 2; ++round) {
+      const double before_m = PathLength(path);
+      slide(path);
+      path = pull(path);
+      if (before_m - PathLength(path) < 1e-4) break;
+    }
+  }
+  return path;
+}
+
+PlanResult Planner::Replan(const PlanRequest& request, const std::vector<Eigen::Vector2d>& path,
+                           size_t next_index) const {
+  const Eigen::Vector2d robot(request.start_x_m, request.start_y_m);
+  const Eigen::Vector2d goal(request.goal_x_m, request.goal_y_m);
+  if (next_index < path.size() && (path.back() - goal).norm() < 1e-6 && IsClear(robot) &&
+      SegmentIsClear(robot, path[next_index]) && PathIsClear(path, next_index)) {
+    PlanResult result;
+    result.status = PlanStatus::kSolved;
+    result.path.push_back(robot);
+    for (size_t i = next_index; i < path.size(); ++i) {
+      if ((path[i] - result.path.back()).norm() > 1e-9) result.path.push_back(path[i]);
+    }
+    if (result.path.size() < 2) result.path.push_back(path.back());
+    result.length_m = PathLength(result.path);
+    result.travel_time_s =
+        TravelTime(robot_.drive, result.path, request.start_heading_deg, request.goal_heading_deg);
+    result.stops = StopPoints(result.path, options_.stop_spacing_m, request.goal_heading_deg);
+    return result;
+  }
+  PlanResult result = Plan(request);
+  result.replanned = true;
+  return result;
+}
+
 PlanResult Planner::Plan(const PlanRequest& request) const {
   if (grid_.cells.empty()) throw std::invalid_argument("Planner::Plan: no map set");
   PlanResult result;
@@ -194,15 +413,16 @@ PlanResult Planner::Plan(const PlanRequest& request) const {
     return result;
   }
 
-  // Validity: one lookup in the inflated grid; motions checked every check_resolution_m.
+  // Validity: one lookup in the inflated grid; motions through SegmentIsClear().
   setup.setStateValidityChecker([this](const ob::State* state) {
     const auto* s = state->as<ob::RealVectorStateSpace::StateType>();
     return IsClear(Eigen::Vector2d(s->values[0], s->values[1]));
   });
-  const double step_m =
-      options_.check_resolution_m > 0 ? options_.check_resolution_m : grid_.cell_m / 4;
+  const double step_m = check_step_m();
   setup.getSpaceInformation()->setStateValidityCheckingResolution(step_m /
                                                                   space->getMaximumExtent());
+  setup.getSpaceInformation()->setMotionValidator(
+      std::make_shared<GridMotionValidator>(setup.getSpaceInformation(), *this));
   ob::ScopedState<ob::RealVectorStateSpace> start_state(space), goal_state(space);
   start_state[0] = start.x();
   start_state[1] = start.y();
@@ -211,35 +431,65 @@ PlanResult Planner::Plan(const PlanRequest& request) const {
   setup.setStartAndGoalStates(start_state, goal_state);
   setup.setPlanner(planner);
 
-  // Solve, then simplify with what is left of the budget.
-  const ob::PlannerStatus status =
-      setup.solve(ob::timedPlannerTerminationCondition(request.time_budget_s));
-  if (status == ob::PlannerStatus::EXACT_SOLUTION) {
-    result.status = PlanStatus::kSolved;
-  } else if (status == ob::PlannerStatus::APPROXIMATE_SOLUTION) {
-    result.status = PlanStatus::kApproximate;
-  } else if (status == ob::PlannerStatus::INVALID_START) {
-    result.status = PlanStatus::kInvalidStart;
-  } else if (status == ob::PlannerStatus::INVALID_GOAL) {
-    result.status = PlanStatus::kInvalidGoal;
-  } else {
-    result.status = PlanStatus::kTimedOut;
+  // Solve, then simplify with what is left of the budget. RRTConnect keeps the first path it
+  // finds, which may go the long way round an obstacle: it gets several attempts within the
+  // budget, each simplified and shortened, and the shortest wins.
+  const bool rrtconnect = request.planner == "rrtconnect";
+  const int attempts = rrtconnect ? std::max(1, options_.rrtconnect_attempts) : 1;
+  const auto began = std::chrono::steady_clock::now();
+  auto left_s = [&] {
+    return request.time_budget_s -
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  };
+  double best_m = std::numeric_limits<double>::infinity();
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    if (attempt > 0) {
+      if (left_s() <= 0.0) break;
+      setup.clear();
+    }
+    const ob::PlannerStatus status =
+        setup.solve(ob::timedPlannerTerminationCondition(std::max(left_s(), 1e-4)));
+    PlanStatus attempt_status = PlanStatus::kTimedOut;
+    if (status == ob::PlannerStatus::EXACT_SOLUTION) {
+      attempt_status = PlanStatus::kSolved;
+    } else if (status == ob::PlannerStatus::APPROXIMATE_SOLUTION) {
+      attempt_status = PlanStatus::kApproximate;
+    } else if (status == ob::PlannerStatus::INVALID_START) {
+      attempt_status = PlanStatus::kInvalidStart;
+    } else if (status == ob::PlannerStatus::INVALID_GOAL) {
+      attempt_status = PlanStatus::kInvalidGoal;
+    }
+    if (attempt == 0) result.status = attempt_status;
+    if (attempt_status != PlanStatus::kSolved && attempt_status != PlanStatus::kApproximate) {
+      continue;
+    }
+    if (attempt_status == PlanStatus::kApproximate && result.status == PlanStatus::kSolved) {
+      continue;  // an earlier attempt found a path to the goal
+    }
+    if (rrtconnect) setup.simplifySolution(std::max(0.005, left_s()));
+    std::vector<Eigen::Vector2d> points;
+    const og::PathGeometric& path = setup.getSolutionPath();
+    for (size_t i = 0; i < path.getStateCount(); ++i) {
+      const auto* s = path.getState(i)->as<ob::RealVectorStateSpace::StateType>();
+      points.emplace_back(s->values[0], s->values[1]);
+    }
+    if (rrtconnect && options_.shorten && attempt_status == PlanStatus::kSolved) {
+      points = Shorten(std::move(points));
+    }
+    const double length_m = PathLength(points);
+    if (attempt_status == PlanStatus::kSolved && result.status != PlanStatus::kSolved) {
+      best_m = std::numeric_limits<double>::infinity();  // a path to the goal beats any other
+      result.status = PlanStatus::kSolved;
+    }
+    if (length_m < best_m) {
+      best_m = length_m;
+      result.path = std::move(points);
+    }
+    if (attempt_status != PlanStatus::kSolved) break;  // approximate: no more attempts
   }
-  if (result.status != PlanStatus::kSolved && result.status != PlanStatus::kApproximate) {
-    return result;
-  }
-  if (request.planner == "rrtconnect") {
-    const double left_s =
-        std::max(0.005, request.time_budget_s - setup.getLastPlanComputationTime());
-    setup.simplifySolution(left_s);
-  }
+  if (result.path.empty()) return result;
 
-  // Path, stops and timing.
-  const og::PathGeometric& path = setup.getSolutionPath();
-  for (size_t i = 0; i < path.getStateCount(); ++i) {
-    const auto* s = path.getState(i)->as<ob::RealVectorStateSpace::StateType>();
-    result.path.emplace_back(s->values[0], s->values[1]);
-  }
+  // Stops and timing.
   result.length_m = PathLength(result.path);
   result.travel_time_s =
       TravelTime(robot_.drive, result.path, request.start_heading_deg, request.goal_heading_deg);

@@ -1,7 +1,8 @@
 // `slamo plan`: a path for the robot across a season's field with its starting objects (as
 // the simulator places them from the seed), planned with OMPL on the object map's 2D grid.
 // Prints the status, length, estimated travel time and the observation stops, and can draw
-// the plan over the field. Exit status: 0 with a path, 1 without one, 2 on bad input.
+// the plan over the field and export it as a LemLib / PATH.JERRYIO path file. Exit status: 0
+// with a path, 1 without one (or when a file cannot be written), 2 on bad input.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -19,6 +20,7 @@
 #include "autonomy/field_picture.h"
 #include "field_configs/loader.h"
 #include "mapping/object_map.h"
+#include "planning/export.h"
 #include "planning/planner.h"
 #include "platform/sim_world.h"
 
@@ -36,6 +38,7 @@ struct PlanArgs {
   double stop_spacing_m = 0.3;
   bool no_objects = false;  // plan on the walls and structures only
   std::string out;
+  std::string export_file;  // LemLib path file (PATH.JERRYIO's LemLib v0.4 format)
 };
 
 // "X,Y,TH_DEG" -> (x, y, heading), or nullopt when malformed.
@@ -181,6 +184,27 @@ int Plan(const PlanArgs& args) {
     }
     std::printf("wrote %s\n", args.out.c_str());
   }
+  if (!args.export_file.empty()) {
+    if (!has_path) {
+      std::cerr << "error: --export: no path to export\n";
+      return 1;
+    }
+    planning::LemLibExportOptions export_options;
+    export_options.robot_width_in = robot.width_m / planning::kMetresPerInch;
+    export_options.robot_length_in = robot.length_m / planning::kMetresPerInch;
+    export_options.start_heading_deg = from->z();
+    export_options.goal_heading_deg = to->z();
+    export_options.name = "slamo " + season.season;
+    try {
+      planning::WriteLemLibPath(args.export_file, result.path, export_options);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 1;
+    }
+    std::printf("wrote %s (%zu points, LemLib v0.4 / PATH.JERRYIO, inches)\n",
+                args.export_file.c_str(),
+                planning::LemLibPoints(result.path, export_options).size());
+  }
   return has_path ? 0 : 1;
 }
 
@@ -210,6 +234,8 @@ void RegisterPlanCommand(CLI::App& app, CommandAction* action) {
   plan->add_flag("--no-objects", args->no_objects,
                  "plan on the walls and structures only (no starting objects)");
   plan->add_option("--out,-o", args->out, "PNG of the plan over the field");
+  plan->add_option("--export", args->export_file,
+                   "LemLib path file of the route (PATH.JERRYIO's LemLib v0.4 format, inches)");
   plan->callback([action, args] { *action = [args] { return Plan(*args); }; });
 }
 

@@ -122,6 +122,133 @@ TEST_F(PlannerTest, EnclosedGoalEndsUnsolvedWithinBudget) {
   EXPECT_LT(elapsed_s, request.time_budget_s + 0.5);  // a bound, not a benchmark
 }
 
+// A large ball across the straight line from the red start to (0.3, -1.2).
+mapping::MappedObject BallAcrossThePath(int id) {
+  mapping::MappedObject ball;
+  ball.id = id;
+  ball.type = "large_ball";
+  ball.colour = "red";
+  ball.centre_m = {-0.612, -0.448, 0.2};
+  ball.radius_m = 0.2;
+  ball.height_m = 0.4;
+  return ball;
+}
+
+TEST_F(PlannerTest, PathIsClearChecksTheRemainingSegments) {
+  const Planner planner = MakePlanner(*season_);
+  const std::vector<Eigen::Vector2d> path = {{-1.524, 0.3048}, {-1.0, -0.5}, {0.3, -1.2}};
+  EXPECT_TRUE(planner.PathIsClear(path));
+  EXPECT_TRUE(planner.PathIsClear(path, 1));
+  EXPECT_TRUE(planner.PathIsClear(path, 2));  // the goal alone
+  EXPECT_FALSE(planner.PathIsClear(path, 3));
+  EXPECT_FALSE(planner.PathIsClear({}));
+  // Through the red goal (0.45, 0.61): the first segment is blocked, the rest is not.
+  const std::vector<Eigen::Vector2d> through = {{-0.5, 0.61}, {1.2, 0.61}, {1.2, -0.3}};
+  ASSERT_TRUE(planner.IsClear(through[0]));
+  ASSERT_TRUE(planner.IsClear(through[1]));
+  EXPECT_FALSE(planner.PathIsClear(through));
+  EXPECT_TRUE(planner.PathIsClear(through, 1));
+}
+
+TEST_F(PlannerTest, ReplansWhenAnObjectLandsOnThePath) {
+  mapping::ObjectMapOptions map_options;
+  map_options.resolution_m = 0.02;
+  mapping::ObjectMap map(*season_, map_options);
+  Planner planner(*robot_);
+  planner.SetMap(map);
+  SeedPlanners(7);
+  PlanRequest request = Request(-1.524, 0.3048, 0.3, -1.2);
+  const PlanResult first = planner.Plan(request);
+  ASSERT_EQ(first.status, PlanStatus::kSolved);
+  ASSERT_TRUE(planner.PathIsClear(first.path));
+
+  // Nothing changed: the rest of the path is kept, from where the robot is.
+  PlanRequest again = request;
+  const Eigen::Vector2d robot = first.path[0] + 0.1 * (first.path[1] - first.path[0]).normalized();
+  again.start_x_m = robot.x();
+  again.start_y_m = robot.y();
+  const PlanResult kept = planner.Replan(again, first.path, 1);
+  EXPECT_EQ(kept.status, PlanStatus::kSolved);
+  EXPECT_FALSE(kept.replanned);
+  ASSERT_EQ(kept.path.size(), first.path.size());
+  EXPECT_TRUE(kept.path.front().isApprox(robot));
+  EXPECT_NEAR(kept.length_m, first.length_m - 0.1, 1e-9);
+
+  // A ball lands across the path: the path is blocked and Replan() goes round it.
+  map.SetObjects({BallAcrossThePath(1)});
+  planner.SetMap(map);
+  EXPECT_FALSE(planner.PathIsClear(first.path));
+  const PlanResult replanned = planner.Replan(again, first.path, 1);
+  ASSERT_EQ(replanned.status, PlanStatus::kSolved) << PlanStatusName(replanned.status);
+  EXPECT_TRUE(replanned.replanned);
+  EXPECT_TRUE(replanned.path.front().isApprox(robot));
+  EXPECT_TRUE(replanned.path.back().isApprox(Eigen::Vector2d(0.3, -1.2)));
+  EXPECT_TRUE(planner.PathIsClear(replanned.path));
+  ExpectPathClear(planner, replanned.path);
+  EXPECT_GT(replanned.length_m, kept.length_m);
+}
+
+TEST_F(PlannerTest, TheTargetObjectIsNoObstacle) {
+  mapping::ObjectMapOptions map_options;
+  map_options.resolution_m = 0.02;
+  mapping::ObjectMap map(*season_, map_options);
+  const std::vector<mapping::MappedObject> objects = {BallAcrossThePath(4)};
+  map.SetObjects(objects);
+  const std::vector<Eigen::Vector2d> line = {{-1.524, 0.3048}, {0.3, -1.2}};
+  const Eigen::Vector2d ball(-0.612, -0.448);
+
+  Planner planner(*robot_);
+  planner.SetMap(map);  // every object is an obstacle
+  EXPECT_FALSE(planner.IsClear(ball));
+  EXPECT_FALSE(planner.PathIsClear(line));
+  planner.SetMap(map, objects);  // the same objects, none ignored
+  EXPECT_FALSE(planner.PathIsClear(line));
+  planner.SetMap(map, objects, {4});  // object 4 is the target
+  EXPECT_TRUE(planner.IsClear(ball));
+  EXPECT_TRUE(planner.PathIsClear(line));
+  // The map itself keeps the object.
+  EXPECT_TRUE(map.IsOccupied({ball.x(), ball.y(), 0.2}));
+
+  PlannerOptions options;
+  options.ignore_object_ids = {4};
+  Planner ignoring(*robot_, options);
+  ignoring.SetMap(map, objects);
+  EXPECT_TRUE(ignoring.PathIsClear(line));
+  // Other objects still count.
+  mapping::MappedObject other = BallAcrossThePath(5);
+  ignoring.SetMap(map, {objects[0], other});
+  EXPECT_FALSE(ignoring.PathIsClear(line));
+}
+
+TEST_F(PlannerTest, ShortenKeepsTheEndsAndNeverLengthens) {
+  const Planner planner = MakePlanner(*season_);
+  // A zigzag in open floor pulls to the straight line.
+  const std::vector<Eigen::Vector2d> zigzag = {
+      {1.0, -1.0}, {1.2, -0.5}, {1.0, 0.0}, {1.3, 0.5}, {1.0, 1.0}};
+  ASSERT_TRUE(planner.PathIsClear(zigzag));
+  const std::vector<Eigen::Vector2d> taut = planner.Shorten(zigzag);
+  EXPECT_EQ(taut.size(), 2u);
+  EXPECT_TRUE(taut.front().isApprox(zigzag.front()));
+  EXPECT_TRUE(taut.back().isApprox(zigzag.back()));
+  // OMPL's path round a ball (simplified, not shortened): no longer, still clear.
+  mapping::ObjectMapOptions map_options;
+  map_options.resolution_m = 0.02;
+  mapping::ObjectMap map(*season_, map_options);
+  map.SetObjects({BallAcrossThePath(1)});
+  PlannerOptions options;
+  options.shorten = false;
+  Planner loose(*robot_, options);
+  loose.SetMap(map);
+  SeedPlanners(3);
+  const PlanResult result = loose.Plan(Request(-1.524, 0.3048, 0.3, -1.2));
+  ASSERT_EQ(result.status, PlanStatus::kSolved);
+  const std::vector<Eigen::Vector2d> around = loose.Shorten(result.path);
+  EXPECT_LE(PathLength(around), result.length_m + 1e-12);
+  EXPECT_TRUE(loose.PathIsClear(around));
+  EXPECT_TRUE(around.front().isApprox(result.path.front()));
+  EXPECT_TRUE(around.back().isApprox(result.path.back()));
+}
+
 TEST(StopPointsTest, StopsAreAtMostSpacingApart) {
   const std::vector<Eigen::Vector2d> path = {{0, 0}, {1.0, 0}, {1.0, 0.75}, {0.2, 1.1}};
   const double spacing_m = 0.3;
