@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
       "  slamo eval vision --frames 50             detection methods against ground truth\n"
       "  slamo replay --log run.log --truth t.tum --out DIR   EKF SLAM over a log; ATE\n"
       "  slamo map build --out DIR                 the OctoMap: map.bt, map.ot, grid.png\n"
-      "  slamo plan --no-objects --from -1.524,0.3048,0 --to 0.3,-1.2,90 --out plan.png   a path");
+      "  slamo plan --no-objects --from -1.524,0.3048,0 --to 0.3,-1.2,90 --out plan.png   a path\n"
+      "  slamo record --sim --script \"forward 0.3; turn 90\" --out run   TUM folder + rawlog");
 
   slamo::autonomy::CommandAction action;
   slamo::autonomy::RegisterFieldCommand(app, &action);
@@ -34,6 +35,8 @@ int main(int argc, char** argv) {
   slamo::autonomy::RegisterExperimentCommand(app, &action);
   slamo::autonomy::RegisterMapCommand(app, &action);
   slamo::autonomy::RegisterPlanCommand(app, &action);
+  slamo::autonomy::RegisterBoardCommand(app, &action);
+  slamo::autonomy::RegisterRecordCommand(app, &action);
 
   try {
     app.parse(argc, argv);

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "field_configs/config_error.h"
 #include "field_configs/internal/yaml_reader.h"
 
@@ -492,18 +494,39 @@ std::string ResolveRobotPath(const std::string& robot_or_path) {
   return Resolve(robot_or_path, fs::path(ConfigDir()) / "robots", ListRobots(), "robot");
 }
 
+namespace {
+
+// yaml-cpp's own exceptions (e.g. a bad conversion when a map key is itself a sequence or a
+// map, `[1, 2]: 3`, found by tests/fuzz/field_config_fuzzer) as a ConfigError, so a bad file
+// exits with status 2 and a message instead of terminating the program.
+ConfigError YamlShapeError(const YAML::Exception& e, const std::string& file) {
+  const bool known = !e.mark.is_null();
+  return ConfigError(file, known ? e.mark.line + 1 : 0, known ? e.mark.column + 1 : 0, "(document)",
+                     "YAML of the expected shape (" + e.msg + ")");
+}
+
+}  // namespace
+
 SeasonConfig ParseSeasonConfig(const std::string& yaml_text, const std::string& file) {
   SeasonConfig config;
   config.source_file = file;
   config.season = Stem(file);
-  SeasonParser(&config).Parse(YamlReader::FromText(yaml_text, file));
+  try {
+    SeasonParser(&config).Parse(YamlReader::FromText(yaml_text, file));
+  } catch (const YAML::Exception& e) {
+    throw YamlShapeError(e, file);
+  }
   return config;
 }
 
 RobotConfig ParseRobotConfig(const std::string& yaml_text, const std::string& file) {
   RobotConfig robot;
   robot.source_file = file;
-  ParseRobot(YamlReader::FromText(yaml_text, file), &robot);
+  try {
+    ParseRobot(YamlReader::FromText(yaml_text, file), &robot);
+  } catch (const YAML::Exception& e) {
+    throw YamlShapeError(e, file);
+  }
   return robot;
 }
 

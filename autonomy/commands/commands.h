@@ -38,4 +38,10 @@ void RegisterMapCommand(CLI::App& app, CommandAction* action);
 // `slamo plan`: an OMPL path across the field, its stops and travel time.
 void RegisterPlanCommand(CLI::App& app, CommandAction* action);
 
+// `slamo record`: a run saved as a TUM RGB-D folder and an MRPT rawlog (--sim: the simulator).
+void RegisterRecordCommand(CLI::App& app, CommandAction* action);
+
+// `slamo board fake|ping`: the motor-controller board link (fake board on a pty, ping).
+void RegisterBoardCommand(CLI::App& app, CommandAction* action);
+
 }  // namespace slamo::autonomy
