@@ -90,6 +90,14 @@ class Runner {
     DriveStepResult result;
     result.step = step;
     bool done = true;
+    if (clock_->NowS() >= options_.hard_deadline_s) {
+      sim_->Stop();
+      result.status = DriveStepStatus::kDeadline;
+      result.end_time_s = clock_->NowS();
+      result.true_pose = sim_->true_pose();
+      result.odometry_pose = odometry_.pose();
+      return result;
+    }
     switch (step.kind) {
       case DriveStepKind::kTurn: {
         const double amount_rad = step.amount * kPi / 180.0;
@@ -106,11 +114,15 @@ class Runner {
       case DriveStepKind::kWait: {
         sim_->Stop();
         const long ticks = std::lround(step.amount / options_.control_dt_s);
-        for (long i = 0; i < ticks; ++i) Tick();
+        long i = 0;
+        for (; i < ticks && clock_->NowS() < options_.hard_deadline_s; ++i) Tick();
+        done = i == ticks;
         break;
       }
     }
-    result.status = done ? DriveStepStatus::kDone : DriveStepStatus::kTimedOut;
+    result.status = done                                         ? DriveStepStatus::kDone
+                    : clock_->NowS() >= options_.hard_deadline_s ? DriveStepStatus::kDeadline
+                                                                 : DriveStepStatus::kTimedOut;
     result.end_time_s = clock_->NowS();
     result.true_pose = sim_->true_pose();
     result.odometry_pose = odometry_.pose();
@@ -119,7 +131,8 @@ class Runner {
 
  private:
   double Deadline(double nominal_s) const {
-    return clock_->NowS() + options_.timeout_factor * nominal_s + options_.timeout_margin_s;
+    return std::min(options_.hard_deadline_s, clock_->NowS() + options_.timeout_factor * nominal_s +
+                                                  options_.timeout_margin_s);
   }
 
   // One controller period: simulator and clock advance together, then the encoders are read.
@@ -133,9 +146,10 @@ class Runner {
 
   // The next wheel speed of a ramp: accelerate to cruise, decelerate to reach 0 at the end.
   double RampSpeed(double speed_mps, double remaining_m) const {
-    return std::min({speed_mps + options_.accel_mps2 * options_.control_dt_s,
-                     options_.cruise_speed_mps,
-                     std::sqrt(2.0 * options_.accel_mps2 * std::max(0.0, remaining_m))});
+    const double ramp = std::min(
+        {speed_mps + options_.accel_mps2 * options_.control_dt_s, options_.cruise_speed_mps,
+         std::sqrt(2.0 * options_.accel_mps2 * std::max(0.0, remaining_m))});
+    return std::max(ramp, std::min(options_.min_speed_mps, options_.cruise_speed_mps));
   }
 
   // Turns in place by amount_rad by the encoders; false on timeout.

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -40,8 +41,11 @@ struct DriveStep {
 std::vector<DriveStep> ParseDriveScript(const std::string& script);
 
 struct DriveControllerOptions {
-  double cruise_speed_mps = 0.067;   // wheel speed when driving and turning (m/s)
-  double accel_mps2 = 0.5;           // ramp up and down (m/s^2)
+  double cruise_speed_mps = 0.067;  // wheel speed when driving and turning (m/s)
+  double accel_mps2 = 0.5;          // ramp up and down (m/s^2)
+  // Lowest commanded speed before the target (m/s): the ramp down otherwise ends in a crawl
+  // the motors' deadband stretches to seconds. 0: ramp all the way down.
+  double min_speed_mps = 0.0;
   double control_dt_s = 0.02;        // controller period (s)
   double heading_gain_per_s = 2.0;   // yaw-rate command per radian of heading error (1/s)
   double align_tolerance_deg = 1.0;  // a drive turns first if the heading is off by more (deg)
@@ -50,12 +54,19 @@ struct DriveControllerOptions {
   double max_settle_s = 2.0;         // give up waiting for the wheels to stop after this (s)
   double timeout_factor = 3.0;       // a step times out after this times its nominal duration...
   double timeout_margin_s = 10.0;    // ...plus this (s)
+  // The match's end on the clock (s): motion is commanded to stop when the clock reaches it,
+  // whatever the step; later steps do not start. Infinite: no deadline.
+  double hard_deadline_s = std::numeric_limits<double>::infinity();
 };
 
 // Cruise speed and acceleration from the robot's drive config, other fields defaulted.
 DriveControllerOptions DriveControllerOptionsFor(const field::DriveConfig& drive);
 
-enum class DriveStepStatus { kDone, kTimedOut };
+enum class DriveStepStatus {
+  kDone,
+  kTimedOut,  // the step's own timeout
+  kDeadline,  // stopped (or not started) at options.hard_deadline_s
+};
 
 struct DriveStepResult {
   DriveStep step;

@@ -47,6 +47,7 @@ SimField::SimField(const field::SeasonConfig& season, const field::RobotConfig& 
       drive_(robot.drive, drive_options, seed, start) {
   world_.season = &season_;
   drive_.SetFreeSpaceCheck([this](const Pose2D& pose) { return RobotPoseIsFree(pose); });
+  if (options_.preload) Preload();
   // An object under the robot at the start is pushed clear of it.
   PushOut(start, robot_.length_m, robot_.width_m);
 }
@@ -110,12 +111,24 @@ std::optional<Vector2d> SimField::PushedPosition(const SimObject& object, const 
     if (side == 2) pushed.y() = half.y() + out;
     if (side == 3) pushed.y() = -half.y() - out;
   }
-  const Vector2d world(pose.x_m + c * pushed.x() - s * pushed.y(),
-                       pose.y_m + s * pushed.x() + c * pushed.y());
   const double limit = season_.HalfSize() - r;
-  if (std::abs(world.x()) > limit || std::abs(world.y()) > limit) return std::nullopt;
-  if (PointInBlockingStructure(season_, world, r)) return std::nullopt;
-  return world;
+  const auto valid = [&](const Vector2d& in_robot) -> std::optional<Vector2d> {
+    const Vector2d world(pose.x_m + c * in_robot.x() - s * in_robot.y(),
+                         pose.y_m + s * in_robot.x() + c * in_robot.y());
+    if (std::abs(world.x()) > limit || std::abs(world.y()) > limit) return std::nullopt;
+    if (PointInBlockingStructure(season_, world, r)) return std::nullopt;
+    return world;
+  };
+  if (const auto world = valid(pushed)) return world;
+  // Pinned against a wall or structure: a ball rolls along the bumper and out past its
+  // nearer side instead (a pinned object only blocks when neither side is free).
+  const double side = half.y() + r + options_.push_gap_m;
+  const double first = local.y() >= 0.0 ? 1.0 : -1.0;
+  for (const double sign : {first, -first}) {
+    if (const auto world = valid(Vector2d(std::clamp(local.x(), -half.x(), half.x()), sign * side)))
+      return world;
+  }
+  return std::nullopt;
 }
 
 bool SimField::CanPushOut(const Pose2D& pose, double length_m, double width_m) const {
@@ -178,6 +191,25 @@ std::optional<int> SimField::Pick() {
   best->held = true;
   held_.push_back(best->id);
   return best->id;
+}
+
+void SimField::Preload() {
+  if (HeldCount() >= robot_.intake.capacity) return;
+  const Pose2D& pose = drive_.true_pose();
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  SimObject* best = nullptr;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (SimObject& o : world_.objects) {
+    if (!OnFloor(o) || !field::ScoresFor(season_, o.colour, alliance_)) continue;
+    const Vector2d rel(o.center_m.x() - pose.x_m, o.center_m.y() - pose.y_m);
+    const double ahead = c * rel.x() + s * rel.y();
+    const double side = -s * rel.x() + c * rel.y();
+    if (std::abs(ahead) > robot_.length_m / 2.0 || std::abs(side) > robot_.width_m / 2.0) continue;
+    if (rel.norm() < best_d) best_d = rel.norm(), best = &o;
+  }
+  if (!best) return;
+  best->held = true;
+  held_.push_back(best->id);
 }
 
 std::optional<ReleaseResult> SimField::Release() {

@@ -20,6 +20,10 @@ namespace slamo::platform {
 
 struct SimFieldOptions {
   double push_gap_m = 0.002;  // a pushed object ends this far from the pusher
+  // The match's preload: the object of a colour that scores for the robot's alliance nearest
+  // the robot's centre and under its footprint at the start goes into the intake, as loaded
+  // by hand before the match (other objects there are pushed clear).
+  bool preload = false;
 };
 
 // What a release did: the object, and the goal it landed in with its points (none: floor).
@@ -55,6 +59,8 @@ class SimField {
   // drop point is inside a wall or structure (the object stays held).
   std::optional<ReleaseResult> Release();
   int HeldCount() const;
+  // Ids of the held objects, oldest first.
+  const std::vector<int>& held() const { return held_; }
 
   // Points the alliance has now: each object in its best goal or zone by the season's rules.
   int Score(field::Alliance alliance) const;
@@ -71,6 +77,7 @@ class SimField {
   std::optional<Eigen::Vector2d> PushedPosition(const SimObject& object, const Pose2D& pose,
                                                 double length_m, double width_m) const;
   void StepOpponent(size_t index, double dt_s);
+  void Preload();
 
   field::SeasonConfig season_;
   field::RobotConfig robot_;
