@@ -349,7 +349,7 @@ std::vector<UpdateOutcome> EkfSlam::UpdateFrame(const std::vector<RangeBearing>&
   }
   // Unpaired measurements: a new landmark only when far from every same-signature one.
   for (size_t i = 0; i < frame.size(); ++i) {
-    if (!add[i]) continue;
+    if (!add[i] || !options_.add_landmarks) continue;
     double nearest = std::numeric_limits<double>::infinity();
     for (int j = 0; j < landmark_count(); ++j) {
       if (signatures_[j] == frame[i].signature)

@@ -58,6 +58,9 @@ struct EkfOptions {
   MotionNoise motion;
   AssociationOptions association;
   double max_range_m = 4.5;  // measurements beyond this are ignored
+  // false: the map is surveyed and complete; a measurement that pairs with no landmark is
+  // dropped instead of starting a new one (UpdateFrame reports it kRejected).
+  bool add_landmarks = true;
 };
 
 // What an update did with each measurement.
@@ -93,6 +96,9 @@ class EkfSlam {
   int landmark_id(int index) const { return ids_[index]; }
   const std::string& landmark_signature(int index) const { return signatures_[index]; }
   // Inserts a landmark known in advance (a surveyed field), with its covariance.
+  // Adds `extra` to the pose covariance: the belief widened when measurements show it has
+  // left the truth (relocalisation by the next update).
+  void InflatePoseCovariance(const Eigen::Matrix3d& extra) { p_.topLeftCorner<3, 3>() += extra; }
   void AddKnownLandmark(const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance, int id,
                         const std::string& signature);
 
