@@ -356,7 +356,8 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
 
   const YamlReader drive = root.Required("drive");
   drive.AllowKeys({"wheel_diameter_m", "track_width_m", "max_speed_mps", "cruise_speed_mps",
-                   "turn_rate_dps", "accel_mps2", "encoder_ticks_per_rev", "pwm", "pid"});
+                   "match_speed_mps", "turn_rate_dps", "accel_mps2", "encoder_ticks_per_rev", "pwm",
+                   "pid"});
   DriveConfig& d = robot->drive;
   d.wheel_diameter_m = drive.Required("wheel_diameter_m").InRange(0.01, 0.5);
   const YamlReader track = drive.Required("track_width_m");
@@ -366,6 +367,11 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   const YamlReader cruise = drive.Required("cruise_speed_mps");
   d.cruise_speed_mps = cruise.Positive();
   if (d.cruise_speed_mps > d.max_speed_mps) cruise.Fail("a speed no faster than max_speed_mps");
+  d.match_speed_mps = d.cruise_speed_mps;
+  if (auto match = drive.Optional("match_speed_mps")) {
+    d.match_speed_mps = match->Positive();
+    if (d.match_speed_mps > d.max_speed_mps) match->Fail("a speed no faster than max_speed_mps");
+  }
   d.turn_rate_dps = drive.Required("turn_rate_dps").InRange(1.0, 1080.0);
   d.accel_mps2 = drive.Required("accel_mps2").Positive();
   d.encoder_ticks_per_rev = drive.Required("encoder_ticks_per_rev").InRange(1.0, 100000.0);

@@ -30,6 +30,7 @@ struct DriveConfig {
   double track_width_m = 0.0;          // distance between left and right wheel contact lines
   double max_speed_mps = 0.0;          // wheel surface speed at full PWM
   double cruise_speed_mps = 0.067;     // speed used when driving between stops
+  double match_speed_mps = 0.067;      // speed in a match's autonomous period (default: cruise)
   double turn_rate_dps = 0.0;          // turn-in-place rate used for planning
   double accel_mps2 = 0.0;             // acceleration limit of the speed ramps
   double encoder_ticks_per_rev = 0.0;  // at the wheel
