@@ -22,6 +22,9 @@ int main(int argc, char** argv) {
       "  slamo eval vision --frames 50             detection methods against ground truth\n"
       "  slamo replay --log run.log --truth t.tum --out DIR   EKF SLAM over a log; ATE\n"
       "  slamo map build --out DIR                 the OctoMap: map.bt, map.ot, grid.png\n"
+      "  slamo dry-run                             a simulated autonomous period: report, map, "
+      "replay\n"
+      "  slamo tune --matches 50 --param strategy=planner,greedy --jobs 2   ranked over seeds\n"
       "  slamo plan --no-objects --from -1.524,0.3048,0 --to 0.3,-1.2,90 --out plan.png   a path\n"
       "  slamo record --sim --script \"forward 0.3; turn 90\" --out run   TUM folder + rawlog");
 
@@ -36,6 +39,9 @@ int main(int argc, char** argv) {
   slamo::autonomy::RegisterMapCommand(app, &action);
   slamo::autonomy::RegisterPlanCommand(app, &action);
   slamo::autonomy::RegisterBoardCommand(app, &action);
+  slamo::autonomy::RegisterDryRunCommand(app, &action);
+  slamo::autonomy::RegisterTuneCommand(app, &action);
+  slamo::autonomy::RegisterMatchCommand(app, &action);
   slamo::autonomy::RegisterRecordCommand(app, &action);
 
   try {

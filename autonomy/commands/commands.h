@@ -41,6 +41,15 @@ void RegisterPlanCommand(CLI::App& app, CommandAction* action);
 // `slamo record`: a run saved as a TUM RGB-D folder and an MRPT rawlog (--sim: the simulator).
 void RegisterRecordCommand(CLI::App& app, CommandAction* action);
 
+// `slamo dry-run`: one simulated autonomous period with its report.
+void RegisterDryRunCommand(CLI::App& app, CommandAction* action);
+
+// `slamo match`: the match-day run on the robot (says what is missing until it exists).
+void RegisterMatchCommand(CLI::App& app, CommandAction* action);
+
+// `slamo tune`: many seeded matches per parameter combination, ranked (and `tune merge`).
+void RegisterTuneCommand(CLI::App& app, CommandAction* action);
+
 // `slamo board fake|ping`: the motor-controller board link (fake board on a pty, ping).
 void RegisterBoardCommand(CLI::App& app, CommandAction* action);
 

@@ -1,0 +1,187 @@
+// The match loop. Everything the robot does in the autonomous period happens in RunMatch,
+// in this order: read what SLAM-O believes (its frames and encoders were taken in by the last
+// action), ask the strategy for the next action, refuse it if it cannot finish before the
+// deadline, carry it out (plan, drive, observe, pick, release: MatchWorld), tell the strategy
+// how it went, and go round again until the deadline.
+#include "autonomy/executive.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "strategy/strategy.h"
+
+namespace slamo::autonomy {
+namespace {
+
+using strategy::ActionKind;
+
+// Tracked objects against where the objects really are at the end.
+std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
+  std::vector<ObjectReport> out;
+  for (const mapping::TrackedObject& o : world.tracker().objects()) {
+    if (!world.tracker().Confirmed(o)) continue;
+    ObjectReport r;
+    r.id = o.id;
+    r.kind = o.kind;
+    r.colour = o.colour;
+    r.estimate_m = o.position_m;
+    r.covariance = o.covariance;
+    double best = 0.5;
+    for (const platform::SimObject& t : world.sim().world().objects) {
+      if (t.held || t.type->name != o.kind || t.colour != o.colour) continue;
+      const double e = (t.center_m.head<2>() - o.position_m).norm();
+      if (e < best) best = e, r.matched = true, r.truth_m = t.center_m.head<2>(), r.error_m = e;
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace
+
+MatchResult RunMatch(const field::SeasonConfig& season, const field::RobotConfig& robot,
+                     const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
+                     const std::function<void(const TimelineEntry&)>& progress) {
+  return RunMatchWith(strategy::MakeStrategy(setup.strategy, setup.strategy_options), season, robot,
+                      setup, seed, out_dir, progress);
+}
+
+MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
+                         const field::SeasonConfig& season, const field::RobotConfig& robot,
+                         const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
+                         const std::function<void(const TimelineEntry&)>& progress) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  MatchSetup match_setup = setup;
+  // The thesis baseline is the thesis's rule: a fixed count of frames at every stop.
+  if (strategy->name() == "thesis") {
+    match_setup.frames.rule = mapping::FrameRule::kFixed;
+    match_setup.frames.fixed_frames = setup.strategy_options.thesis_frames;
+  }
+  MatchWorld world(season, robot, match_setup, seed, strategy->perceives());
+
+  MatchResult result;
+  result.season = season.season;
+  result.seed = seed;
+  result.strategy = strategy->name();
+  result.frames = mapping::Describe(match_setup.frames);
+  result.deadline_s = world.deadline_s();
+  result.points_start = world.Points();
+
+  int idle_actions = 0;  // actions that took no time: a strategy going round in circles
+  while (world.time_left_s() > 0.0) {
+    // 1. What the robot believes now, and what the strategy makes of it.
+    const strategy::Belief belief = world.Belief();
+    const strategy::Action action = strategy->Next(belief, world.Context());
+    TimelineEntry entry;
+    entry.t_s = world.now_s();
+    entry.action = strategy::ActionName(action.kind);
+    entry.detail = action.why;
+    entry.expected_s = action.expected_s;
+    if (progress) progress(entry);
+
+    // 2. Nothing worth doing: stand still until the deadline.
+    if (action.kind == ActionKind::kIdle) {
+      world.IdleToDeadline();
+      entry.end_s = world.now_s();
+      result.idle_s += entry.end_s - entry.t_s;
+      result.timeline.push_back(entry);
+      break;
+    }
+
+    // 3. The deadline, part one: an action that cannot finish in the time left does not start.
+    if (action.expected_s > world.time_left_s()) {
+      entry.action = "REFUSED";
+      entry.detail = std::string(strategy::ActionName(action.kind)) + " needs " +
+                     std::to_string(action.expected_s).substr(0, 4) + " s, " +
+                     std::to_string(world.time_left_s()).substr(0, 4) + " s left: " + action.why;
+      entry.ok = false;
+      entry.end_s = world.now_s();
+      result.timeline.push_back(entry);
+      ++result.refused;
+      strategy->Feedback(action, false);
+      if (++idle_actions >= 20) {
+        world.IdleToDeadline();
+        break;
+      }
+      continue;
+    }
+
+    // 4. Carry it out. The deadline, part two: every motion inside stops when the clock
+    //    reaches it (DriveControllerOptions::hard_deadline_s), whatever the action.
+    world.set_action_label(entry.action + " " + action.why);
+    bool ok = false;
+    switch (action.kind) {
+      case ActionKind::kObserve:
+        if (action.look_heading) world.TurnTo(action.target.z());
+        ok = world.Observe(action.frames) > 0 || !strategy->perceives();
+        break;
+      case ActionKind::kNavigate:
+        // A drive that takes twice its estimate (and 3 s) is stuck or lost: give it up. (The
+        // thesis's stops are not in the estimate: no limit for them.)
+        ok = world.Navigate(action.target, action.stop_spacing_m, action.frames,
+                            action.stop_spacing_m > 0.0 ? 0.0 : 2.0 * action.expected_s + 3.0);
+        break;
+      case ActionKind::kPick:
+        ok = world.Pick(action);
+        break;
+      case ActionKind::kScore:
+        ok = world.Score(action);
+        break;
+      case ActionKind::kIdle:
+        break;
+    }
+
+    // 5. Tell the strategy, and account for the time.
+    strategy->Feedback(action, ok);
+    entry.ok = ok;
+    entry.end_s = world.now_s();
+    const double spent = entry.end_s - entry.t_s;
+    switch (action.kind) {
+      case ActionKind::kObserve:
+        result.observe_s += spent;
+        break;
+      case ActionKind::kNavigate:
+        result.drive_s += spent;
+        break;
+      default:
+        result.score_s += spent;
+        break;
+    }
+    result.timeline.push_back(entry);
+    if (spent <= 1e-9 && ++idle_actions >= 20) {
+      world.IdleToDeadline();
+      break;
+    }
+  }
+
+  // The report: points, timing, and SLAM-O against the simulator's truth.
+  result.points = world.Points();
+  result.overrun_s = world.overrun_s();
+  result.duration_s = std::min(world.last_motion_s(), world.deadline_s() + result.overrun_s);
+  double sum_sq = 0.0;
+  for (const PoseSample& s : world.samples())
+    sum_sq += (s.estimate - s.truth).head<2>().squaredNorm();
+  result.pose_ate_m = world.samples().empty() ? 0.0 : std::sqrt(sum_sq / world.samples().size());
+  result.frames_taken = world.frames();
+  result.replans = world.replans();
+  result.relocalisations = world.relocalisations();
+  result.rejected_frames = world.rejected_frames();
+  result.odometry_scale = world.odometry_scale();
+  result.objects = ScoreObjects(world);
+  result.samples = world.samples();
+  result.snapshots = world.snapshots();
+  result.paths = world.paths();
+  result.landmark_truth = world.landmark_truth();
+  for (int i = 0; i < world.ekf().landmark_count(); ++i) {
+    result.landmark_estimates.push_back(world.ekf().landmark(i));
+    result.landmark_covariances.push_back(world.ekf().landmark_covariance(i));
+  }
+  result.field = world.field();
+  if (!out_dir.empty()) world.object_map().WriteBinary(out_dir + "/objects.bt");
+  result.wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return result;
+}
+
+}  // namespace slamo::autonomy

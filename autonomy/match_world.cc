@@ -1,0 +1,664 @@
+#include "autonomy/match_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+#include "platform/sim_world.h"
+
+namespace slamo::autonomy {
+namespace {
+
+using platform::DriveStep;
+using platform::DriveStepKind;
+using platform::Pose2D;
+
+constexpr double kPi = 3.14159265358979323846;
+
+mapping::OdometryStep Increment(const Pose2D& from, const Pose2D& to) {
+  const double c = std::cos(from.theta_rad), s = std::sin(from.theta_rad);
+  const double dx = to.x_m - from.x_m, dy = to.y_m - from.y_m;
+  return {c * dx + s * dy, -s * dx + c * dy, platform::WrapAngleRad(to.theta_rad - from.theta_rad)};
+}
+
+DriveStep Turn(double degrees) {
+  return {DriveStepKind::kTurn, degrees, "turn " + std::to_string(degrees)};
+}
+DriveStep Forward(double metres) {
+  return {DriveStepKind::kDrive, metres,
+          (metres >= 0 ? "forward " : "back ") + std::to_string(std::abs(metres))};
+}
+
+const field::StartTile& StartFor(const field::SeasonConfig& season, field::Alliance alliance,
+                                 int index) {
+  int seen = 0;
+  for (const field::StartTile& s : season.starts) {
+    if (s.alliance == alliance && seen++ == index) return s;
+  }
+  throw std::invalid_argument(season.name + " has no starting tile " + std::to_string(index) +
+                              " for that alliance");
+}
+
+// Frames taken to check an arrival, and how close counts as arrived.
+// Cut the motors this long before the target at the current speed: the slow creep of the last
+// centimetres (PWM deadband) costs more time than the coast-in error SLAM-O corrects.
+constexpr double kStopLead_s = 0.15;
+constexpr double kMinSpeed_mps = 0.06;
+
+// How far the robot backs off a goal after a release.
+constexpr double kBackOff_m = 0.15;
+
+// A per-frame measurement bias shared by a stop's frames (range m, bearing rad), so that
+// iterating frames does not shrink the covariance below what the camera's bias allows.
+const Eigen::Matrix2d kStopBias = Eigen::Vector2d(0.01 * 0.01, 0.005 * 0.005).asDiagonal();
+
+// The robot as driven in a match: at its match speed (or `speed_mps`), turning in place at
+// that wheel speed, which is what the drive controller does.
+field::RobotConfig MatchRobot(const field::RobotConfig& robot, double speed_mps) {
+  field::RobotConfig out = robot;
+  out.drive.cruise_speed_mps = speed_mps > 0.0 ? std::min(speed_mps, robot.drive.max_speed_mps)
+                                               : robot.drive.match_speed_mps;
+  out.drive.turn_rate_dps =
+      out.drive.cruise_speed_mps / (robot.drive.track_width_m / 2.0) * 180.0 / kPi;
+  return out;
+}
+
+// What a team measures before it trusts its encoders: drive 1 m straight a few times on an
+// empty floor and compare the true distance (a tape measure) with what the encoders say. The
+// mean ratio scales every commanded distance and every odometry increment; SLAM-O is left the
+// random part of the slip.
+double CalibrateOdometryScale(const field::RobotConfig& robot) {
+  double ratio = 0.0;
+  const int runs = 5;
+  for (int i = 0; i < runs; ++i) {
+    const std::vector<platform::DriveStepResult> r =
+        platform::SimulateDriveScript("forward 1.0", robot, platform::SimDriveOptions{}, 1000 + i);
+    const double truth = std::hypot(r.back().true_pose.x_m, r.back().true_pose.y_m);
+    const double encoders = std::hypot(r.back().odometry_pose.x_m, r.back().odometry_pose.y_m);
+    ratio += truth / encoders;
+  }
+  return ratio / runs;
+}
+
+}  // namespace
+
+field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m,
+                                 uint64_t seed) {
+  field::SeasonConfig out = season;
+  if (jitter_m <= 0.0) return out;
+  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + 17);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (field::ObjectPlacement& p : out.objects) {
+    if (!p.position_m || p.z_m > 0.0) continue;
+    const Eigen::Vector2d nominal(p.position_m->x, p.position_m->y);
+    const bool preload =
+        std::any_of(season.starts.begin(), season.starts.end(), [&](const field::StartTile& s) {
+          return (nominal - Eigen::Vector2d(s.center_m.x, s.center_m.y)).norm() < 0.3;
+        });
+    if (preload) continue;
+    const field::ObjectType* type = season.FindObjectType(p.type);
+    const double r = type ? type->size_m / 2.0 : 0.1;
+    for (int attempt = 0; attempt < 30; ++attempt) {
+      const Eigen::Vector2d c = nominal + jitter_m * Eigen::Vector2d(unit(rng), unit(rng));
+      const double limit = season.HalfSize() - r;
+      if (std::abs(c.x()) > limit || std::abs(c.y()) > limit) continue;
+      if (platform::PointInBlockingStructure(season, c, r)) continue;
+      p.position_m = field::Vec2{c.x(), c.y()};
+      break;
+    }
+  }
+  return out;
+}
+
+MatchWorld::MatchWorld(const field::SeasonConfig& season, const field::RobotConfig& robot,
+                       const MatchSetup& setup, uint64_t seed, bool perceive)
+    : field_(PlaceObjects(season, setup.placement_jitter_m, seed)),
+      robot_(MatchRobot(robot, setup.drive_speed_mps)),
+      setup_(setup),
+      perceive_(perceive),
+      deadline_s_(season.rules.autonomous_s),
+      ekf_(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-6),
+      object_map_(field_),
+      obstacle_map_(field_),
+      gyro_(seed),
+      travel_(robot_.drive) {
+  const field::StartTile& start = StartFor(field_, setup.alliance, setup.start_index);
+  const Pose2D start_pose{start.center_m.x, start.center_m.y, start.heading_deg * kPi / 180.0};
+  platform::SimFieldOptions sim_options;
+  sim_options.preload = true;
+  sim_ = std::make_unique<platform::SimField>(field_, robot_, setup.alliance, seed, start_pose,
+                                              platform::SimDriveOptions{}, sim_options);
+  renderer_ = std::make_unique<platform::SimRenderer>(field_, robot_.camera,
+                                                      platform::RenderOptions{}, seed);
+  landmark_detector_ = vision::LandmarkDetectorSetup(field_, &robot_.camera);
+  object_detector_ = vision::ObjectDetectorSetup(field_, &robot_.camera);
+  // The starting tile is known to a centimetre and a degree.
+  mapping::EkfOptions ekf_options;
+  ekf_options.add_landmarks = false;  // the surveyed markers are all there is
+  ekf_ = mapping::EkfSlam(Eigen::Vector3d(start_pose.x_m, start_pose.y_m, start_pose.theta_rad),
+                          Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal(),
+                          ekf_options);
+  // The team surveys the markers it puts on the perimeter: they enter the filter as known
+  // landmarks; a colour shared by several is associated by position (JCBB).
+  marker_id_.assign(field_.landmarks.size(), -1);
+  for (size_t i = 0; i < field_.landmarks.size(); ++i) {
+    const auto same = std::count_if(
+        field_.landmarks.begin(), field_.landmarks.end(),
+        [&](const field::Landmark& l) { return l.colour == field_.landmarks[i].colour; });
+    if (same == 1) marker_id_[i] = static_cast<int>(i);
+    ekf_.AddKnownLandmark(renderer_->landmark_centres()[i].head<2>(),
+                          Eigen::Matrix2d::Identity() * 1e-6, marker_id_[i],
+                          field_.landmarks[i].colour);
+  }
+  // The preload: loaded by hand, so its kind and colour are known.
+  if (!sim_->held().empty()) {
+    for (const platform::SimObject& o : sim_->world().objects) {
+      if (o.id != sim_->held().front()) continue;
+      strategy::ObjectBelief held;
+      held.id = -1;
+      held.kind = o.type->name;
+      held.colour = o.colour;
+      held_ = held;
+    }
+  }
+  odometry_ = sim_->drive().odometry_pose();
+  gyro_heading_ = gyro_.Read(start_pose.theta_rad, 0.0);
+  odometry_scale_ = CalibrateOdometryScale(robot_);
+  drive_options_ = platform::DriveControllerOptionsFor(robot_.drive);
+  drive_options_.hard_deadline_s = deadline_s_;
+  drive_options_.timeout_margin_s = 2.0;  // a blocked step gives up quickly in a match
+  // Do not wait for the last encoder tick of a coasting wheel: the odometry keeps counting
+  // it into the next step.
+  drive_options_.max_settle_s = 0.4;
+  drive_options_.stop_lead_s = kStopLead_s;
+  drive_options_.min_speed_mps = kMinSpeed_mps;
+
+  planning::PlannerOptions planner_options;
+  planner_options.stop_spacing_m = 0.0;
+  planner_ = std::make_unique<planning::Planner>(robot_, planner_options);
+  planning::SeedPlanners(seed);
+  planner_->SetMap(obstacle_map_);
+  travel_.SetPlanner(*planner_);
+
+  context_.season = &field_;
+  context_.robot = &robot_;
+  context_.alliance = setup.alliance;
+  context_.frame_rate_hz = robot_.camera.frame_rate_hz;
+  context_.travel_time_s = [this](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+    return travel_.TravelTimeS(from, to);
+  };
+  context_.is_clear = [this](const Eigen::Vector2d& p) { return planner_->IsClear(p); };
+  RecordSample();
+  MaybeSnapshot(true);
+}
+
+strategy::Belief MatchWorld::Belief() const {
+  strategy::Belief b;
+  b.now_s = clock_.NowS();
+  b.deadline_s = deadline_s_;
+  b.pose = ekf_.pose();
+  b.pose_covariance = ekf_.pose_covariance();
+  b.held = held_;
+  for (const mapping::TrackedObject& o : tracker_.objects()) {
+    if (!tracker_.Confirmed(o)) continue;
+    if (std::find(picked_ids_.begin(), picked_ids_.end(), o.id) != picked_ids_.end()) continue;
+    b.objects.push_back({o.id, o.kind, o.colour, o.position_m, o.covariance, o.confidence});
+  }
+  return b;
+}
+
+std::vector<Eigen::Vector2d> MatchWorld::landmark_truth() const {
+  std::vector<Eigen::Vector2d> out;
+  for (const Eigen::Vector3d& c : renderer_->landmark_centres()) out.push_back(c.head<2>());
+  return out;
+}
+
+double MatchWorld::ObjectRadius(const std::string& kind) const {
+  const field::ObjectType* type = field_.FindObjectType(kind);
+  return type ? type->size_m / 2.0 : 0.1;
+}
+
+void MatchWorld::Advance(double dt_s) {
+  sim_->Step(dt_s);
+  const platform::SimDriveBase& d = sim_->drive();
+  const bool driven =
+      d.left_pwm() != robot_.drive.pwm.stop || d.right_pwm() != robot_.drive.pwm.stop;
+  // The clock still shows the start of this step.
+  if (driven) {
+    last_motion_s_ = clock_.NowS() + dt_s;
+    if (clock_.NowS() >= deadline_s_) overrun_s_ += dt_s;
+  }
+}
+
+void MatchWorld::RecordSample() {
+  const Pose2D& t = sim_->robot_pose();
+  samples_.push_back({clock_.NowS(), Eigen::Vector3d(t.x_m, t.y_m, t.theta_rad), ekf_.pose(),
+                      ekf_.pose_covariance()});
+}
+
+void MatchWorld::MaybeSnapshot(bool force) {
+  if (setup_.snapshot_period_s <= 0.0) return;
+  if (!force && clock_.NowS() < next_snapshot_s_) return;
+  next_snapshot_s_ = clock_.NowS() + setup_.snapshot_period_s;
+  Snapshot s;
+  s.t_s = clock_.NowS();
+  s.truth = sim_->robot_pose();
+  // Between filter updates the estimate is the last one moved by the encoders since.
+  mapping::OdometryStep u = Increment(odometry_, sim_->drive().odometry_pose());
+  u.dx_m *= odometry_scale_;
+  u.dy_m *= odometry_scale_;
+  s.estimate = mapping::EkfSlam::Move(ekf_.pose(), u, nullptr, nullptr);
+  s.covariance = ekf_.pose_covariance();
+  for (const platform::SimObject& o : sim_->world().objects) {
+    if (o.held) continue;
+    s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.type->size_m / 2.0});
+  }
+  s.tracked = Belief().objects;
+  s.action = action_label_;
+  s.points = Points();
+  snapshots_.push_back(std::move(s));
+}
+
+bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
+  const std::vector<platform::DriveStepResult> results =
+      platform::RunDriveScript(steps, drive_options_, &sim_->drive(), &clock_, [this](double dt) {
+        Advance(dt);
+        MaybeSnapshot();
+      });
+  const Pose2D now = sim_->drive().odometry_pose();
+  mapping::OdometryStep u = Increment(odometry_, now);
+  u.dx_m *= odometry_scale_;
+  u.dy_m *= odometry_scale_;
+  if (setup_.gyro) {
+    // Gyro-aided odometry: the turn comes from the gyro, which sees the body turn; the
+    // encoders' turn is wrong whenever a wheel slips (and a turn blocked by a pinned object
+    // spins the wheels without turning the robot at all).
+    const double heading = gyro_.Read(sim_->robot_pose().theta_rad, clock_.NowS());
+    u.dtheta_rad = platform::WrapAngleRad(heading - gyro_heading_);
+    gyro_heading_ = heading;
+  }
+  ekf_.Predict(u);
+  odometry_ = now;
+  RecordSample();
+  return std::all_of(results.begin(), results.end(), [](const platform::DriveStepResult& r) {
+    return r.status == platform::DriveStepStatus::kDone;
+  });
+}
+
+void MatchWorld::Wait(double seconds) { Drive({DriveStep{DriveStepKind::kWait, seconds, "wait"}}); }
+
+int MatchWorld::Observe(int max_frames) {
+  if (!perceive_ || max_frames <= 0) return 0;
+  mapping::FrameSelectionOptions rule = setup_.frames;
+  rule.max_frames = std::min(rule.max_frames, max_frames);
+  rule.fixed_frames = std::min(rule.fixed_frames, max_frames);
+  rule.gmm_max_frames = std::min(rule.gmm_max_frames, max_frames);
+  rule.gmm_min_frames = std::min(rule.gmm_min_frames, max_frames);
+  mapping::FrameSelector selector(rule);
+  selector.Start(ekf_.pose_covariance());
+  platform::RgbdFrame rgbd;
+  int taken = 0;
+  bool last_tracked = false;
+  bool relocalised = false;
+  const Pose2D truth = sim_->robot_pose();
+  for (int frame = 1; clock_.NowS() < deadline_s_; ++frame) {
+    rgbd = renderer_->Render(sim_->world(), truth, clock_.NowS(), nullptr);
+    std::vector<mapping::RangeBearing> measurements;
+    for (const vision::Detection& d :
+         vision::Detect(rgbd.colour, rgbd.depth_mm, landmark_detector_, {})) {
+      if (!d.measurement) continue;
+      int index = -1;
+      for (size_t i = 0; i < field_.landmarks.size(); ++i) {
+        if (field_.landmarks[i].colour == d.colour) index = static_cast<int>(i);
+      }
+      if (index < 0) continue;
+      mapping::RangeBearing z;
+      z.range_m = d.measurement->range_m;
+      z.bearing_rad = d.measurement->bearing_rad;
+      z.covariance = mapping::IteratedFrameCovariance(d.measurement->covariance, kStopBias, frame);
+      z.id = marker_id_[index];
+      z.signature = d.colour;
+      measurements.push_back(z);
+    }
+    // A frame whose update would throw the pose off the field or jump it further than the
+    // belief allows (3 sigma, at least 0.3 m) paired wrongly: it is dropped.
+    const auto plausible = [&](const mapping::EkfSlam& prior) {
+      const Eigen::Vector2d jump = ekf_.pose().head<2>() - prior.pose().head<2>();
+      const double allowed =
+          std::max(0.3, 3.0 * std::sqrt(prior.pose_covariance().topLeftCorner<2, 2>().trace()));
+      const double half = field_.HalfSize();
+      return jump.norm() <= allowed && std::abs(ekf_.pose().x()) < half &&
+             std::abs(ekf_.pose().y()) < half;
+    };
+    const mapping::EkfSlam prior = ekf_;
+    std::vector<mapping::UpdateOutcome> outcomes = ekf_.UpdateFrame(measurements);
+    if (!plausible(prior)) {
+      ekf_ = prior;
+      outcomes.assign(measurements.size(), mapping::UpdateOutcome::kRejected);
+      ++rejected_frames_;
+    }
+    const bool paired = std::any_of(outcomes.begin(), outcomes.end(), [](mapping::UpdateOutcome o) {
+      return o == mapping::UpdateOutcome::kUpdated;
+    });
+    if (!paired && !measurements.empty() && !relocalised) {
+      // Markers in view and none fits: the estimate has left the truth (the wheels spun while
+      // the robot pushed something it could not move; the encoders cannot tell). Widen the
+      // pose belief and pair again: first a little, needing one marker; then more, needing
+      // two (the markers' colours repeat point-symmetrically, so a single pairing under a
+      // wide belief could be the twin). A result off the field or beyond the widened belief
+      // is dropped.
+      relocalised = true;
+      const mapping::EkfSlam before = ekf_;
+      const struct {
+        double sigma_m, sigma_deg;
+        long needed;
+      } steps[] = {{0.2, 40.0, 1}, {0.6, 60.0, 2}};
+      for (const auto& step : steps) {
+        ekf_.InflatePoseCovariance(Eigen::Vector3d(step.sigma_m * step.sigma_m,
+                                                   step.sigma_m * step.sigma_m,
+                                                   std::pow(step.sigma_deg * kPi / 180.0, 2))
+                                       .asDiagonal());
+        const mapping::EkfSlam widened = ekf_;
+        const std::vector<mapping::UpdateOutcome> retry = ekf_.UpdateFrame(measurements);
+        const auto updated =
+            std::count(retry.begin(), retry.end(), mapping::UpdateOutcome::kUpdated);
+        if (updated >= step.needed && plausible(widened)) {
+          ++relocalisations_;
+          break;
+        }
+        ekf_ = widened;
+        if (&step == &steps[1]) ekf_ = before;
+      }
+    }
+    // Objects on the first frame and the last: two sightings confirm an object, so a single
+    // stop can map what it sees; a false detection rarely survives both.
+    if (frame == 1) TrackObjects(rgbd);
+    last_tracked = frame == 1;
+    ++taken;
+    ++frames_;
+    const double dt = 1.0 / robot_.camera.frame_rate_hz;
+    Advance(dt);
+    clock_.Advance(dt);
+    RecordSample();
+    MaybeSnapshot();
+    if (!selector.Continue(ekf_.pose(), ekf_.pose_covariance())) break;
+  }
+  if (taken == 0) return 0;
+  if (!last_tracked) TrackObjects(rgbd);
+  UpdateMaps();
+  return taken;
+}
+
+void MatchWorld::TrackObjects(const platform::RgbdFrame& rgbd) {
+  std::vector<mapping::ObjectObservation> seen;
+  for (const vision::Detection& d :
+       vision::Detect(rgbd.colour, rgbd.depth_mm, object_detector_, {})) {
+    if (!d.measurement) continue;
+    seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
+                    d.measurement->covariance});
+  }
+  // Placed through the best pose estimate (and its covariance).
+  const Eigen::Vector3d pose = ekf_.pose();
+  const double half_fov = std::atan(robot_.camera.width_px / 2.0 / robot_.camera.fx) - 0.05;
+  tracker_.Update(pose, ekf_.pose_covariance(), seen, clock_.NowS(), [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d z = mapping::EkfSlam::Observe(pose, p);
+    return z.x() > 0.8 && z.x() < 3.5 && std::abs(z.y()) < half_fov;
+  });
+}
+
+void MatchWorld::UpdateMaps() {
+  // Objects narrower than half the robot are pushed aside by it (the simulator's contact
+  // rule; VEX robots sweep small balls): they are mapped but not planned around. Larger ones
+  // are obstacles: pushed, they pin against others and stop the robot.
+  std::vector<mapping::MappedObject> all, obstacles;
+  for (const strategy::ObjectBelief& o : Belief().objects) {
+    const field::ObjectType* type = field_.FindObjectType(o.kind);
+    if (!type) continue;
+    const mapping::MappedObject m{
+        o.id,
+        o.kind,
+        o.colour,
+        Eigen::Vector3d(o.position_m.x(), o.position_m.y(), type->height_m / 2.0),
+        type->size_m / 2.0,
+        type->height_m,
+        o.confidence};
+    all.push_back(m);
+    if (type->size_m < setup_.pushable_fraction * robot_.width_m) continue;
+    // An obstacle without the clearance margin: grazing a ball only nudges it, and the full
+    // margin would close the approaches to the goals the balls lie around.
+    mapping::MappedObject obstacle = m;
+    obstacle.radius_m =
+        std::max(0.02, m.radius_m - planner_->inflation_radius_m() + robot_.width_m / 2.0);
+    obstacles.push_back(obstacle);
+  }
+  object_map_.SetObjects(all);
+  obstacle_map_.SetObjects(obstacles);
+  planner_->SetMap(obstacle_map_);
+  travel_.SetPlanner(*planner_);
+}
+
+bool MatchWorld::TurnTo(double heading_rad) {
+  const double turn = platform::WrapAngleRad(heading_rad - ekf_.pose().z());
+  if (std::abs(turn) < 2.0 * kPi / 180.0) return true;
+  return Drive({Turn(turn * 180.0 / kPi)});
+}
+
+bool MatchWorld::PathClear(const std::vector<Eigen::Vector2d>& path) const {
+  // A robot standing inside the clearance margin (after a close approach) may leave it: the
+  // stretch that starts blocked is not held against the path.
+  bool leaving = !path.empty() && !planner_->IsClear(path.front());
+  for (size_t i = 1; i < path.size(); ++i) {
+    const double length = (path[i] - path[i - 1]).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(length / 0.02)));
+    for (int k = 0; k <= n; ++k) {
+      const bool clear =
+          planner_->IsClear(path[i - 1] + (path[i] - path[i - 1]) * (static_cast<double>(k) / n));
+      if (clear) leaving = false;
+      if (!clear && !leaving) return false;
+    }
+  }
+  return true;
+}
+
+bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, int frames_per_stop,
+                          double budget_s) {
+  const double give_up_s = budget_s > 0.0 ? clock_.NowS() + budget_s : deadline_s_;
+  const auto out_of_time = [&]() { return clock_.NowS() >= std::min(give_up_s, deadline_s_); };
+  for (int attempt = 0; attempt < 3 && !out_of_time(); ++attempt) {
+    Eigen::Vector3d pose = ekf_.pose();
+    if (!planner_->IsClear(pose.head<2>())) {
+      // After a close approach the robot stands inside the clearance margin: back out, along
+      // its heading, to the nearest clear point behind it (or turn away first if there is none).
+      const Eigen::Vector2d back(-std::cos(pose.z()), -std::sin(pose.z()));
+      double distance = 0.0;
+      for (double d = 0.05; d <= 0.8 + 1e-9; d += 0.05) {
+        if (planner_->IsClear(pose.head<2>() + d * back)) {
+          distance = d + 0.03;
+          break;
+        }
+      }
+      if (distance > 0.0) {
+        Drive({Forward(-distance / odometry_scale_)});
+      } else {
+        Drive({Turn(180.0), Forward(0.3 / odometry_scale_)});
+      }
+      pose = ekf_.pose();
+    }
+    planning::PlanRequest request;
+    request.start_x_m = pose.x();
+    request.start_y_m = pose.y();
+    request.start_heading_deg = pose.z() * 180.0 / kPi;
+    request.goal_x_m = target.x();
+    request.goal_y_m = target.y();
+    request.goal_heading_deg = target.z() * 180.0 / kPi;
+    request.planner = setup_.planner;
+    request.time_budget_s = setup_.plan_budget_s;
+    planning::PlanResult plan = planner_->Plan(request);
+    if (plan.status != planning::PlanStatus::kSolved) {
+      return false;
+    }
+    // Fewer corners, fewer stops to turn: keep only the corners a straight, clear segment
+    // cannot skip (the planner's taut paths bend in small steps round the inflated discs).
+    std::vector<Eigen::Vector2d> corners = {plan.path.front()};
+    for (size_t from = 0; from + 1 < plan.path.size();) {
+      size_t to = plan.path.size() - 1;
+      while (to > from + 1 && !PathClear({plan.path[from], plan.path[to]})) --to;
+      corners.push_back(plan.path[to]);
+      from = to;
+    }
+    plan.path = corners;
+    paths_.push_back(plan.path);
+    // Stops: the strategy's, or (perceiving) a quick look every setup_.check_spacing_m, which
+    // catches obstacles the map did not have and the wheels' slip.
+    const double spacing = stop_spacing_m > 0.0                        ? stop_spacing_m
+                           : perceive_ && setup_.check_spacing_m > 0.0 ? setup_.check_spacing_m
+                                                                       : 0.0;
+    const int stop_frames = stop_spacing_m > 0.0 ? frames_per_stop : setup_.correction_frames;
+    // The path's corners, with stops added along each leg every `spacing` (a stop never cuts
+    // a corner: the legs between stops are the plan's own).
+    std::vector<Eigen::Vector2d> waypoints;
+    for (size_t k = 1; k < plan.path.size(); ++k) {
+      const Eigen::Vector2d a = plan.path[k - 1], b = plan.path[k];
+      const int pieces =
+          spacing > 0.0 ? std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing))) : 1;
+      for (int j = 1; j <= pieces; ++j)
+        waypoints.push_back(a + (b - a) * (static_cast<double>(j) / pieces));
+    }
+    bool replan = false;
+    double unseen_m =
+        setup_.check_spacing_m;  // driven since the last look (look before the first leg)
+    for (size_t i = 0; i < waypoints.size() && !replan; ++i) {
+      if (out_of_time()) return false;
+      // Each segment is aimed from the latest estimate: SLAM-O corrects the encoders' drift.
+      Eigen::Vector3d est = ekf_.pose();
+      Eigen::Vector2d d = waypoints[i] - est.head<2>();
+      if (d.norm() < 0.02) continue;
+      const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+      // The thesis's stops come at every stop point; the quick looks once per
+      // setup_.check_spacing_m.
+      const bool stop_here = stop_spacing_m > 0.0 || unseen_m + 1e-6 >= setup_.check_spacing_m;
+      unseen_m = stop_here ? d.norm() : unseen_m + d.norm();
+      if (spacing > 0.0 && stop_frames > 0 && stop_here) {
+        // Face the segment, look along it, and plan again if the map now blocks the rest.
+        if (std::abs(turn) > 3.0 * kPi / 180.0) Drive({Turn(turn * 180.0 / kPi)});
+        Observe(stop_frames);
+        // The planned legs ahead (the leg from here is the plan's, up to the drift the
+        // estimate just corrected).
+        std::vector<Eigen::Vector2d> rest = {i == 0 ? pose.head<2>() : waypoints[i - 1]};
+        rest.insert(rest.end(), waypoints.begin() + static_cast<long>(i), waypoints.end());
+        if (!PathClear(rest)) {
+          replan = true, ++replans_;
+          break;
+        }
+        est = ekf_.pose();
+        d = waypoints[i] - est.head<2>();
+        const double again = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+        std::vector<DriveStep> steps;
+        if (std::abs(again) > 2.0 * kPi / 180.0) steps.push_back(Turn(again * 180.0 / kPi));
+        steps.push_back(Forward(d.norm() / odometry_scale_));
+        Drive(steps);
+      } else {
+        Drive({Turn(turn * 180.0 / kPi), Forward(d.norm() / odometry_scale_)});
+      }
+    }
+    if (replan) continue;
+    // Arrival, closed on SLAM-O: observe, and drive the rest while the estimate is off.
+    for (int fix = 0; perceive_ && fix < setup_.arrival_fixes && !out_of_time(); ++fix) {
+      Observe(std::max(frames_per_stop, setup_.correction_frames));
+      const Eigen::Vector2d d = target.head<2>() - ekf_.pose().head<2>();
+      if (d.norm() < setup_.arrival_tolerance_m) break;
+      const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - ekf_.pose().z());
+      if (std::abs(turn) > kPi / 2) {  // overshot: back up rather than turn round
+        Drive({Turn(platform::WrapAngleRad(turn + kPi) * 180.0 / kPi),
+               Forward(-d.norm() / odometry_scale_)});
+      } else {
+        Drive({Turn(turn * 180.0 / kPi), Forward(d.norm() / odometry_scale_)});
+      }
+    }
+    TurnTo(target.z());
+    return (ekf_.pose().head<2>() - target.head<2>()).norm() < 0.12;
+  }
+  return false;
+}
+
+bool MatchWorld::Pick(const strategy::Action& action) {
+  const strategy::Belief before = Belief();
+  strategy::ObjectBelief target;
+  target.position_m = action.target.head<2>();
+  for (const strategy::ObjectBelief& o : before.objects) {
+    if (o.id == action.object_id) target = o;
+  }
+  if (perceive_) {
+    Observe(std::max(action.frames, setup_.correction_frames));
+    for (const strategy::ObjectBelief& o : Belief().objects) {
+      if (o.id == action.object_id) target = o;
+    }
+  }
+  const double r =
+      ObjectRadius(target.kind.empty() ? field_.object_types.front().name : target.kind);
+  const Eigen::Vector3d est = ekf_.pose();
+  const Eigen::Vector2d d = target.position_m - est.head<2>();
+  const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+  const double forward = d.norm() - strategy::PickDistance(robot_, r);
+  std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};
+  if (std::abs(forward) > 0.01) steps.push_back(Forward(forward / odometry_scale_));
+  Drive(steps);
+  if (clock_.NowS() >= deadline_s_) return false;
+  const std::optional<int> picked = sim_->Pick();
+  Wait(context_.robot ? setup_.strategy_options.pick_s : 1.0);
+  if (!picked) return false;
+  // The intake knows what it took (kind and colour from its own sensor).
+  for (const platform::SimObject& o : sim_->world().objects) {
+    if (o.id != *picked) continue;
+    strategy::ObjectBelief held;
+    held.id = action.object_id;
+    held.kind = o.type->name;
+    held.colour = o.colour;
+    held_ = held;
+  }
+  if (action.object_id >= 0) picked_ids_.push_back(action.object_id);
+  UpdateMaps();
+  return true;
+}
+
+bool MatchWorld::Score(const strategy::Action& action) {
+  if (!held_) return false;
+  const double r = ObjectRadius(held_->kind);
+  const double margin = setup_.strategy_options.approach_margin_m;
+  Observe(setup_.correction_frames);
+  const Eigen::Vector2d drop =
+      strategy::DropTarget(field_, robot_, action.goal_index, action.target, r, margin);
+  const Eigen::Vector3d est = ekf_.pose();
+  const Eigen::Vector2d d = drop - est.head<2>();
+  const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+  const field::Goal& goal = field_.goals[action.goal_index];
+  // Into a goal structure the bumper stops just short of its edge.
+  double forward = d.norm() - strategy::ReleaseDistance(robot_, r);
+  if (goal.kind == field::GoalKind::kGoal) {
+    const double half = goal.shape == field::SolidShape::kCylinder
+                            ? goal.radius_m
+                            : 0.5 * std::min(goal.size_m.x, goal.size_m.y);
+    forward = d.norm() - (half + robot_.length_m / 2.0 + 0.015);
+  }
+  std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};
+  if (std::abs(forward) > 0.01) steps.push_back(Forward(forward / odometry_scale_));
+  Drive(steps);
+  if (clock_.NowS() >= deadline_s_) return false;
+  const std::optional<platform::ReleaseResult> released = sim_->Release();
+  Wait(setup_.strategy_options.release_s);
+  // Back off the goal: pressed against it, the robot could not turn (its corners sweep the
+  // structure) and its wheels would spin in place.
+  if (clock_.NowS() < deadline_s_) Drive({Forward(-kBackOff_m / odometry_scale_)});
+  if (!released) return false;
+  held_.reset();
+  return released->goal_index && *released->goal_index == action.goal_index;
+}
+
+void MatchWorld::IdleToDeadline() {
+  if (clock_.NowS() < deadline_s_) Wait(deadline_s_ - clock_.NowS());
+  MaybeSnapshot(true);
+}
+
+}  // namespace slamo::autonomy

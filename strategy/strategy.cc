@@ -1,0 +1,741 @@
+#include "strategy/strategy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
+#include "field_configs/summary.h"
+#include "platform/sim_world.h"
+
+namespace slamo::strategy {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// A staging pose within this distance counts as reached.
+constexpr double kAtStage_m = 0.25;
+
+double Wrap(double a) {
+  const double w = std::remainder(a, 2.0 * kPi);
+  return w <= -kPi ? w + 2.0 * kPi : w;
+}
+
+double ObjectRadius(const field::SeasonConfig& season, const std::string& kind) {
+  const field::ObjectType* type = season.FindObjectType(kind);
+  return type ? type->size_m / 2.0 : 0.1;
+}
+
+bool InGoalStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p) {
+  for (const field::Goal& g : season.goals) {
+    if (g.kind == field::GoalKind::kGoal && platform::GoalContains(g, p)) return true;
+  }
+  return false;
+}
+
+// One pick-and-score cycle (or only the score, for the held object), timed and valued.
+struct Cycle {
+  const ObjectBelief* object = nullptr;  // nullptr: the held object
+  Eigen::Vector3d pick_stage = Eigen::Vector3d::Zero();
+  int goal = -1;
+  Eigen::Vector3d score_stage = Eigen::Vector3d::Zero();
+  double seconds = 0.0;
+  double gain = 0.0;         // points after - points before
+  double probability = 0.0;  // of the pick and the release both succeeding
+  int frames = 0;            // observed first
+  double Value() const { return probability * gain; }
+};
+
+// What all the perceiving strategies share: candidate cycles, their timing and success
+// probabilities, feedback on failures and the exploratory look.
+class Base : public Strategy {
+ public:
+  explicit Base(const StrategyOptions& options) : options_(options) {}
+
+  void Feedback(const Action& action, bool succeeded) override {
+    if (succeeded) return;
+    if (action.kind == ActionKind::kPick && action.object_id >= 0)
+      ++failed_objects_[action.object_id];
+    if (action.kind == ActionKind::kScore) ++failed_goals_[action.goal_index];
+    if (action.kind == ActionKind::kNavigate) ++failed_targets_[Key(action.target)];
+  }
+
+ protected:
+  // A look is not repeated towards the same 30-degree sector from the same half-metre cell.
+  static long LookKey(const Eigen::Vector3d& pose, double heading) {
+    return (std::lround(pose.x() * 2.0) * 100 + std::lround(pose.y() * 2.0)) * 100 +
+           std::lround(heading / (kPi / 6.0));
+  }
+  static long Key(const Eigen::Vector3d& p) {
+    return std::lround(p.x() * 20.0) * 100000 + std::lround(p.y() * 20.0);
+  }
+
+  // Seconds for the final straight approach of margin_m and the settling around it.
+  double ApproachSeconds(const StrategyContext& c) const {
+    return options_.approach_margin_m / c.robot->drive.cruise_speed_mps + 0.5;
+  }
+
+  // Position variance (worst axis) after n more frames, by the iterated-frame model.
+  double PoseVarianceAfter(const Belief& b, int frames) const {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(
+        b.pose_covariance.topLeftCorner<2, 2>());
+    const double v0 = std::max(eig.eigenvalues().maxCoeff(), 1e-8);
+    if (frames <= 0) return v0;
+    const double w = options_.frame_white_sigma_m, bias = options_.frame_bias_sigma_m;
+    const double vobs = w * w / frames + bias * bias;
+    return 1.0 / (1.0 / v0 + 1.0 / vobs);
+  }
+
+  // Heading error adds lateral error growing with the distance driven; approximated at the
+  // approach distance.
+  double PickProbability(const Belief& b, const ObjectBelief& o, int frames) const {
+    const double pose_var = PoseVarianceAfter(b, frames);
+    const double heading_var = b.pose_covariance(2, 2);
+    Eigen::Matrix2d cov =
+        o.covariance + Eigen::Matrix2d::Identity() * (pose_var + heading_var * 0.25);
+    return SuccessProbability(cov, options_.pick_tolerance_m) * o.confidence;
+  }
+
+  double ScoreProbability(const Belief& b, const StrategyContext& c, int goal, int frames) const {
+    const field::Goal& g = c.season->goals[goal];
+    // A goal structure forgives its radius less the drop's offset; a zone forgives more.
+    const double tolerance =
+        g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * g.radius_m) : 0.3;
+    const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() *
+                                (PoseVarianceAfter(b, frames) + b.pose_covariance(2, 2) * 0.25);
+    return SuccessProbability(cov, tolerance);
+  }
+
+  // Whether the final straight approach from `stage` over `length_m` is free of known
+  // objects (other than `except`): an object pinned between the bumper and a goal stops the
+  // robot short, so such approaches are not offered.
+  static bool CorridorFree(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& stage,
+                           double length_m, int except) {
+    const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
+    for (const ObjectBelief& o : b.objects) {
+      if (o.id == except) continue;
+      const double r = ObjectRadius(*c.season, o.kind);
+      const Eigen::Vector2d rel = o.position_m - stage.head<2>();
+      const double along = rel.dot(dir);
+      const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
+      if (along > -r && along < length_m + c.robot->length_m / 2.0 + r &&
+          side < c.robot->width_m / 2.0 + r) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // The goals an object scores in, with their best staging pose from `from` and the time to
+  // get there and release.
+  struct GoalChoice {
+    int goal = -1;
+    Eigen::Vector3d stage;
+    double seconds = 0.0;
+    int points = 0;
+  };
+  std::vector<GoalChoice> GoalChoices(const Belief& b, const StrategyContext& c,
+                                      const std::string& kind, const std::string& colour,
+                                      const Eigen::Vector3d& from, int except) const {
+    std::vector<GoalChoice> out;
+    const double r = ObjectRadius(*c.season, kind);
+    for (int g = 0; g < static_cast<int>(c.season->goals.size()); ++g) {
+      const int points = GoalPoints(*c.season, g, kind, colour, c.alliance);
+      if (points <= 0) continue;
+      auto failed = failed_goals_.find(g);
+      if (failed != failed_goals_.end() && failed->second >= 2) continue;
+      GoalChoice best;
+      for (const Eigen::Vector3d& stage : ScoreStages(c, g, r, options_.approach_margin_m)) {
+        if (failed_targets_.count(Key(stage))) continue;
+        if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except)) continue;
+        const std::optional<double> t = c.travel_time_s(from, stage);
+        if (!t) continue;
+        const double seconds = *t + ApproachSeconds(c) + options_.release_s;
+        if (best.goal < 0 || seconds < best.seconds) best = {g, stage, seconds, points};
+      }
+      if (best.goal >= 0) out.push_back(best);
+    }
+    return out;
+  }
+
+  bool Scores(const StrategyContext& c, const ObjectBelief& o) const {
+    if (!field::ScoresFor(*c.season, o.colour, c.alliance)) return false;
+    if (InGoalStructure(*c.season, o.position_m)) return false;
+    auto failed = failed_objects_.find(o.id);
+    return failed == failed_objects_.end() || failed->second < 2;
+  }
+
+  // Cycles for one object from `from`: pick it, then each goal that takes it.
+  std::vector<Cycle> ObjectCycles(const Belief& b, const StrategyContext& c, const ObjectBelief& o,
+                                  const Eigen::Vector3d& from, int frames) const {
+    std::vector<Cycle> out;
+    if (!Scores(c, o)) return out;
+    const double r = ObjectRadius(*c.season, o.kind);
+    const std::optional<Eigen::Vector3d> stage =
+        PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m);
+    if (!stage || failed_targets_.count(Key(*stage))) return out;
+    if (!CorridorFree(b, c, *stage, options_.approach_margin_m, o.id)) return out;
+    const std::optional<double> t = c.travel_time_s(from, *stage);
+    if (!t) return out;
+    const double pick_s = *t + ApproachSeconds(c) + options_.pick_s;
+    const double before = FloorPoints(*c.season, o.position_m, o.kind, o.colour, c.alliance);
+    const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
+    const Eigen::Vector3d picked_at(o.position_m.x() - dir.x() * PickDistance(*c.robot, r),
+                                    o.position_m.y() - dir.y() * PickDistance(*c.robot, r),
+                                    stage->z());
+    for (const GoalChoice& g : GoalChoices(b, c, o.kind, o.colour, picked_at, o.id)) {
+      Cycle cycle;
+      cycle.object = &o;
+      cycle.pick_stage = *stage;
+      cycle.goal = g.goal;
+      cycle.score_stage = g.stage;
+      cycle.seconds = pick_s + g.seconds + frames / c.frame_rate_hz;
+      cycle.gain = g.points - before;
+      cycle.probability = PickProbability(b, o, frames) * ScoreProbability(b, c, g.goal, frames);
+      cycle.frames = frames;
+      out.push_back(cycle);
+    }
+    return out;
+  }
+
+  std::vector<Cycle> HeldCycles(const Belief& b, const StrategyContext& c, int frames) const {
+    std::vector<Cycle> out;
+    for (const GoalChoice& g : GoalChoices(b, c, b.held->kind, b.held->colour, b.pose, -1)) {
+      Cycle cycle;
+      cycle.goal = g.goal;
+      cycle.score_stage = g.stage;
+      cycle.seconds = g.seconds + frames / c.frame_rate_hz;
+      cycle.gain = g.points;  // a held object counts nothing until released
+      cycle.probability = ScoreProbability(b, c, g.goal, frames);
+      cycle.frames = frames;
+      out.push_back(cycle);
+    }
+    return out;
+  }
+
+  // The first action of a cycle, given where the robot is.
+  Action FirstAction(const Belief& b, const StrategyContext& c, const Cycle& cycle,
+                     double expected_points) const {
+    Action a;
+    a.expected_points = expected_points;
+    if (cycle.frames > 0) {
+      a.kind = ActionKind::kObserve;
+      a.frames = cycle.frames;
+      a.expected_s = cycle.frames / c.frame_rate_hz;
+      a.why = "pose sigma " + std::to_string(std::sqrt(PoseVarianceAfter(b, 0))).substr(0, 5) +
+              " m: observe before the cycle";
+      return a;
+    }
+    const Eigen::Vector3d stage = cycle.object ? cycle.pick_stage : cycle.score_stage;
+    // Near enough: the pick and the release turn to their target and drive the rest.
+    const bool at_stage = (b.pose.head<2>() - stage.head<2>()).norm() < kAtStage_m;
+    if (!at_stage) {
+      a.kind = ActionKind::kNavigate;
+      a.target = stage;
+      a.expected_s = c.travel_time_s(b.pose, stage).value_or(0.0);
+      a.why = cycle.object ? "to pick " + cycle.object->colour + " " + cycle.object->kind + " #" +
+                                 std::to_string(cycle.object->id)
+                           : "to score in " + c.season->goals[cycle.goal].name;
+      a.object_id = cycle.object ? cycle.object->id : -1;
+      a.goal_index = cycle.goal;
+      return a;
+    }
+    if (cycle.object) {
+      a.kind = ActionKind::kPick;
+      a.object_id = cycle.object->id;
+      a.target =
+          Eigen::Vector3d(cycle.object->position_m.x(), cycle.object->position_m.y(), stage.z());
+      a.frames = 0;
+      a.expected_s = ApproachSeconds(c) + options_.pick_s;
+      a.why =
+          cycle.object->colour + " " + cycle.object->kind + " #" + std::to_string(cycle.object->id);
+    } else {
+      a.kind = ActionKind::kScore;
+      a.goal_index = cycle.goal;
+      a.target = stage;
+      a.expected_s = ApproachSeconds(c) + options_.release_s;
+      a.why = "into " + c.season->goals[cycle.goal].name;
+    }
+    return a;
+  }
+
+  // Turn to look where the season places objects of our colour and none is tracked yet.
+  std::optional<Action> Look(const Belief& b, const StrategyContext& c) {
+    std::vector<Eigen::Vector2d> prior;
+    for (const field::ObjectPlacement& p : c.season->objects) {
+      if (!field::ScoresFor(*c.season, p.colour, c.alliance)) continue;
+      if (p.position_m) {
+        prior.emplace_back(p.position_m->x, p.position_m->y);
+      } else if (p.region) {
+        for (double fx = 0.125; fx < 1.0; fx += 0.25) {
+          for (double fy = 0.125; fy < 1.0; fy += 0.25) {
+            prior.emplace_back(p.region->min_m.x + fx * (p.region->max_m.x - p.region->min_m.x),
+                               p.region->min_m.y + fy * (p.region->max_m.y - p.region->min_m.y));
+          }
+        }
+      }
+    }
+    const double half_fov = std::atan(c.robot->camera.width_px / 2.0 / c.robot->camera.fx) - 0.05;
+    double best_heading = 0.0;
+    int best_count = 0;
+    for (int k = 0; k < 12; ++k) {
+      const double heading = k * kPi / 6.0;
+      if (looked_.count(LookKey(b.pose, heading))) continue;
+      int count = 0;
+      for (const Eigen::Vector2d& p : prior) {
+        const Eigen::Vector2d d = p - b.pose.head<2>();
+        const double range = d.norm();
+        if (range < 0.8 || range > 3.5) continue;
+        if (std::abs(Wrap(std::atan2(d.y(), d.x()) - heading)) > half_fov) continue;
+        const bool known =
+            std::any_of(b.objects.begin(), b.objects.end(),
+                        [&](const ObjectBelief& o) { return (o.position_m - p).norm() < 0.3; });
+        if (!known) ++count;
+      }
+      // Prefer small turns: a turn costs seconds like anything else.
+      if (count > best_count) best_count = count, best_heading = heading;
+    }
+    if (best_count == 0) return std::nullopt;
+    const double turn_s =
+        std::abs(Wrap(best_heading - b.pose.z())) * 180.0 / kPi / c.robot->drive.turn_rate_dps;
+    if (turn_s + options_.look_frames / c.frame_rate_hz > b.deadline_s - b.now_s)
+      return std::nullopt;
+    looked_[LookKey(b.pose, best_heading)] = 1;
+    Action a;
+    a.kind = ActionKind::kObserve;
+    a.look_heading = true;
+    a.target = Eigen::Vector3d(b.pose.x(), b.pose.y(), best_heading);
+    a.frames = options_.look_frames;
+    const double turn_deg = std::abs(Wrap(best_heading - b.pose.z())) * 180.0 / kPi;
+    a.expected_s = turn_deg / c.robot->drive.turn_rate_dps + options_.look_frames / c.frame_rate_hz;
+    a.why = "look where " + std::to_string(best_count) + " prior positions are unseen";
+    return a;
+  }
+
+  StrategyOptions options_;
+  std::map<int, int> failed_objects_;
+  std::map<int, int> failed_goals_;
+  std::map<long, int> failed_targets_;
+  std::map<long, int> looked_;
+  bool surveyed_ = false;
+};
+
+// Our method: the receding-horizon search described in strategy.h.
+class PlannerStrategy : public Base {
+ public:
+  using Base::Base;
+  std::string name() const override { return "planner"; }
+
+  Action Next(const Belief& b, const StrategyContext& c) override {
+    const double left = b.deadline_s - b.now_s;
+    if (!surveyed_) {  // the initial survey: nothing is known before the first frames
+      surveyed_ = true;
+      Action a;
+      a.kind = ActionKind::kObserve;
+      a.frames = options_.look_frames;
+      a.expected_s = a.frames / c.frame_rate_hz;
+      a.why = "initial survey";
+      return a;
+    }
+    Cycle best;
+    double best_j = 0.0, best_rate = 0.0;
+    const auto consider = [&](const Cycle& first, double j, double seconds) {
+      if (seconds > left) return;
+      const double rate = j / std::max(seconds, 1e-3);
+      if (j > best_j + 1e-9 || (std::abs(j - best_j) <= 1e-9 && rate > best_rate)) {
+        best = first, best_j = j, best_rate = rate;
+      }
+    };
+    for (int frames : options_.frame_choices) {
+      if (frames > 0 && just_observed_) continue;  // observing twice in a row gains little
+      std::vector<Cycle> firsts = b.held ? HeldCycles(b, c, frames) : std::vector<Cycle>{};
+      // Held: its goals, floor zones included (releasing it on the floor frees the intake).
+      if (!b.held) {
+        for (const ObjectBelief& o : b.objects) {
+          for (const Cycle& cycle : ObjectCycles(b, c, o, b.pose, frames)) firsts.push_back(cycle);
+        }
+      }
+      for (const Cycle& first : firsts) {
+        consider(first, first.Value(), first.seconds);
+        if (options_.horizon < 2) continue;
+        // The second cycle from where the first ends, with no extra observation; its travel
+        // from the first's goal is the planner's, like the first's.
+        for (const ObjectBelief& o : b.objects) {
+          if (first.object && o.id == first.object->id) continue;
+          for (const Cycle& second : ObjectCycles(b, c, o, first.score_stage, 0)) {
+            consider(first, first.Value() + second.Value(), first.seconds + second.seconds);
+          }
+        }
+      }
+    }
+    if (best.goal >= 0 && best_j >= options_.min_gain) {
+      Action a = FirstAction(b, c, best, best_j);
+      // Check the arrival with as many frames as a look: a pick or release from a wrong
+      // pose wastes the whole cycle.
+      if (a.kind == ActionKind::kNavigate) a.frames = options_.arrival_frames;
+      just_observed_ = a.kind == ActionKind::kObserve;
+      return a;
+    }
+    just_observed_ = false;
+    if (std::optional<Action> look = Look(b, c)) {
+      just_observed_ = true;
+      return *look;
+    }
+    Action idle;
+    idle.why = "nothing worth doing fits in " + std::to_string(left).substr(0, 4) + " s";
+    return idle;
+  }
+
+ private:
+  bool just_observed_ = false;
+};
+
+// Nearest known object of ours (by the planner's travel time), the best-paying goal for it.
+class GreedyStrategy : public Base {
+ public:
+  GreedyStrategy(const StrategyOptions& options, std::string name, double spacing, int frames)
+      : Base(options), name_(std::move(name)), spacing_(spacing), frames_(frames) {}
+  std::string name() const override { return name_; }
+
+  Action Next(const Belief& b, const StrategyContext& c) override {
+    if (!surveyed_) {
+      surveyed_ = true;
+      Action a;
+      a.kind = ActionKind::kObserve;
+      a.frames = frames_ > 0 ? frames_ : options_.look_frames;
+      a.expected_s = a.frames / c.frame_rate_hz;
+      a.why = "initial survey";
+      return a;
+    }
+    std::optional<Cycle> chosen;
+    const double left = b.deadline_s - b.now_s;
+    if (b.held) {
+      for (const Cycle& cycle : HeldCycles(b, c, 0)) {
+        if (cycle.seconds > left) continue;
+        if (!chosen || cycle.gain > chosen->gain ||
+            (cycle.gain == chosen->gain && cycle.seconds < chosen->seconds)) {
+          chosen = cycle;
+        }
+      }
+    } else {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const ObjectBelief& o : b.objects) {
+        std::optional<Cycle> best_goal;
+        for (const Cycle& cycle : ObjectCycles(b, c, o, b.pose, 0)) {
+          if (cycle.gain <= 0 || cycle.seconds > left) continue;
+          if (!best_goal || cycle.gain > best_goal->gain) best_goal = cycle;
+        }
+        if (!best_goal) continue;
+        const double d = (o.position_m - b.pose.head<2>()).norm();
+        if (d < nearest) nearest = d, chosen = best_goal;
+      }
+    }
+    if (chosen) {
+      Action a = FirstAction(b, c, *chosen, chosen->gain);
+      if (a.kind == ActionKind::kNavigate) {
+        a.stop_spacing_m = spacing_;
+        a.frames = frames_;
+      }
+      return a;
+    }
+    if (std::optional<Action> look = Look(b, c)) return *look;
+    Action idle;
+    idle.why = "no known object of ours";
+    return idle;
+  }
+
+ private:
+  std::string name_;
+  double spacing_;
+  int frames_;
+};
+
+// A fixed route from the season's nominal positions, planned once before the match, driven
+// blind: what a team's scripted autonomous does.
+class ScriptedStrategy : public Base {
+ public:
+  using Base::Base;
+  std::string name() const override { return "scripted"; }
+  bool perceives() const override { return false; }
+
+  Action Next(const Belief& b, const StrategyContext& c) override {
+    if (!planned_) Plan(b, c);
+    if (next_ >= route_.size()) {
+      Action idle;
+      idle.why = "end of the script";
+      return idle;
+    }
+    return route_[next_++];
+  }
+
+ private:
+  void Plan(const Belief& b, const StrategyContext& c) {
+    planned_ = true;
+    // The nominal objects: fixed positions from the season file (regions are unknown).
+    std::vector<ObjectBelief> nominal;
+    int id = -1;
+    for (const field::ObjectPlacement& p : c.season->objects) {
+      if (!p.position_m || p.z_m > 0.0) continue;
+      ObjectBelief o;
+      o.id = id--;
+      o.kind = p.type;
+      o.colour = p.colour;
+      o.position_m = Eigen::Vector2d(p.position_m->x, p.position_m->y);
+      o.covariance = Eigen::Matrix2d::Identity() * 1e-6;
+      if ((o.position_m - b.pose.head<2>()).norm() < 0.3) continue;  // the preload
+      nominal.push_back(o);
+    }
+    Belief plan = b;
+    plan.objects.clear();
+    double t = b.now_s;
+    bool held = b.held.has_value();
+    std::optional<ObjectBelief> held_object = b.held;
+    std::vector<bool> used(nominal.size(), false);
+    for (int cycle_index = 0; cycle_index < 4; ++cycle_index) {
+      std::optional<Cycle> chosen;
+      size_t chosen_index = 0;
+      if (held) {
+        plan.held = held_object;
+        for (const Cycle& cycle : HeldCycles(plan, c, 0)) {
+          if (!chosen || cycle.gain / cycle.seconds > chosen->gain / chosen->seconds)
+            chosen = cycle;
+        }
+      } else {
+        for (size_t i = 0; i < nominal.size(); ++i) {
+          if (used[i]) continue;
+          for (const Cycle& cycle : ObjectCycles(plan, c, nominal[i], plan.pose, 0)) {
+            if (cycle.gain <= 0) continue;
+            if (!chosen || cycle.gain / cycle.seconds > chosen->gain / chosen->seconds) {
+              chosen = cycle, chosen_index = i;
+            }
+          }
+        }
+      }
+      if (!chosen || t + chosen->seconds > b.deadline_s) break;
+      Action nav;
+      nav.kind = ActionKind::kNavigate;
+      if (!held) {
+        nav.target = chosen->pick_stage;
+        nav.expected_s = c.travel_time_s(plan.pose, nav.target).value_or(0.0);
+        nav.object_id = nominal[chosen_index].id;
+        nav.why =
+            "script: to nominal " + nominal[chosen_index].colour + " " + nominal[chosen_index].kind;
+        route_.push_back(nav);
+        Action pick;
+        pick.kind = ActionKind::kPick;
+        pick.object_id = nominal[chosen_index].id;
+        pick.target = Eigen::Vector3d(nominal[chosen_index].position_m.x(),
+                                      nominal[chosen_index].position_m.y(), chosen->pick_stage.z());
+        pick.expected_s = ApproachSeconds(c) + options_.pick_s;
+        pick.why = "script: pick";
+        route_.push_back(pick);
+        used[chosen_index] = true;
+        held_object = nominal[chosen_index];
+        const double r = ObjectRadius(*c.season, nominal[chosen_index].kind);
+        const Eigen::Vector2d dir(std::cos(chosen->pick_stage.z()),
+                                  std::sin(chosen->pick_stage.z()));
+        plan.pose = Eigen::Vector3d(
+            nominal[chosen_index].position_m.x() - dir.x() * PickDistance(*c.robot, r),
+            nominal[chosen_index].position_m.y() - dir.y() * PickDistance(*c.robot, r),
+            chosen->pick_stage.z());
+      }
+      nav.target = chosen->score_stage;
+      nav.object_id = -1;
+      nav.goal_index = chosen->goal;
+      nav.expected_s = c.travel_time_s(plan.pose, nav.target).value_or(0.0);
+      nav.why = "script: to " + c.season->goals[chosen->goal].name;
+      route_.push_back(nav);
+      Action score;
+      score.kind = ActionKind::kScore;
+      score.goal_index = chosen->goal;
+      score.target = chosen->score_stage;
+      score.expected_s = ApproachSeconds(c) + options_.release_s;
+      score.why = "script: release";
+      route_.push_back(score);
+      plan.pose = chosen->score_stage;
+      t += chosen->seconds;
+      held = false;
+      held_object.reset();
+      plan.held.reset();
+    }
+  }
+
+  bool planned_ = false;
+  std::vector<Action> route_;
+  size_t next_ = 0;
+};
+
+}  // namespace
+
+const char* ActionName(ActionKind kind) {
+  switch (kind) {
+    case ActionKind::kObserve:
+      return "OBSERVE";
+    case ActionKind::kNavigate:
+      return "NAVIGATE";
+    case ActionKind::kPick:
+      return "PICK";
+    case ActionKind::kScore:
+      return "SCORE";
+    case ActionKind::kIdle:
+      return "IDLE";
+  }
+  return "?";
+}
+
+const std::vector<std::string>& StrategyNames() {
+  static const std::vector<std::string> names = {"planner", "greedy", "scripted", "thesis"};
+  return names;
+}
+
+std::unique_ptr<Strategy> MakeStrategy(const std::string& name, const StrategyOptions& options) {
+  if (name == "planner") return std::make_unique<PlannerStrategy>(options);
+  if (name == "greedy") return std::make_unique<GreedyStrategy>(options, "greedy", 0.0, 10);
+  if (name == "thesis") {
+    return std::make_unique<GreedyStrategy>(options, "thesis", options.thesis_spacing_m,
+                                            options.thesis_frames);
+  }
+  if (name == "scripted") return std::make_unique<ScriptedStrategy>(options);
+  throw std::invalid_argument("unknown strategy \"" + name +
+                              "\" (planner, greedy, scripted, thesis)");
+}
+
+int GoalPoints(const field::SeasonConfig& season, int goal_index, const std::string& kind,
+               const std::string& colour, field::Alliance alliance) {
+  if (goal_index < 0 || goal_index >= static_cast<int>(season.goals.size())) return 0;
+  if (!field::ScoresFor(season, colour, alliance)) return 0;
+  const field::Goal& g = season.goals[goal_index];
+  if (g.alliance != field::Alliance::kNone && g.alliance != alliance) return 0;
+  const auto it = g.points.find(kind);
+  return it == g.points.end() ? 0 : it->second;
+}
+
+int FloorPoints(const field::SeasonConfig& season, const Eigen::Vector2d& position_m,
+                const std::string& kind, const std::string& colour, field::Alliance alliance) {
+  int best = 0;
+  for (int g = 0; g < static_cast<int>(season.goals.size()); ++g) {
+    if (season.goals[g].kind != field::GoalKind::kZone) continue;
+    if (!platform::GoalContains(season.goals[g], position_m)) continue;
+    best = std::max(best, GoalPoints(season, g, kind, colour, alliance));
+  }
+  return best;
+}
+
+double PickDistance(const field::RobotConfig& robot, double object_radius_m) {
+  return robot.length_m / 2.0 + object_radius_m + robot.intake.reach_m / 2.0;
+}
+
+double ReleaseDistance(const field::RobotConfig& robot, double object_radius_m) {
+  return robot.length_m / 2.0 + object_radius_m + 0.01;
+}
+
+std::optional<Eigen::Vector3d> PickStage(const StrategyContext& context,
+                                         const Eigen::Vector2d& object, double object_radius_m,
+                                         const Eigen::Vector2d& from, double margin_m) {
+  const double d = PickDistance(*context.robot, object_radius_m) + margin_m;
+  Eigen::Vector2d u = object - from;
+  const double base = u.norm() > 1e-6 ? std::atan2(u.y(), u.x()) : 0.0;
+  for (double offset_deg :
+       {0.0, 30.0, -30.0, 60.0, -60.0, 90.0, -90.0, 120.0, -120.0, 150.0, -150.0, 180.0}) {
+    const double heading = base + offset_deg * kPi / 180.0;
+    const Eigen::Vector2d stage =
+        object - d * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+    if (context.is_clear(stage)) return Eigen::Vector3d(stage.x(), stage.y(), Wrap(heading));
+  }
+  return std::nullopt;
+}
+
+std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goal_index,
+                                         double object_radius_m, double margin_m) {
+  const field::Goal& g = context.season->goals[goal_index];
+  const field::RobotConfig& robot = *context.robot;
+  std::vector<Eigen::Vector3d> out;
+  const Eigen::Vector2d centre(g.center_m.x, g.center_m.y);
+  if (g.kind == field::GoalKind::kGoal) {
+    // Bumper just short of the goal's edge; the drop then lands inside it.
+    const double half = g.shape == field::SolidShape::kCylinder
+                            ? g.radius_m
+                            : 0.5 * std::min(g.size_m.x, g.size_m.y);
+    const double reach = half + robot.length_m / 2.0 + 0.015;
+    if (std::abs(reach - ReleaseDistance(robot, object_radius_m)) > half) return out;
+    // The robot at the release must not overlap anything but the goal's own structure (a goal
+    // against a barrier is reached from its open side only).
+    field::SeasonConfig others = *context.season;
+    others.structures.erase(std::remove_if(others.structures.begin(), others.structures.end(),
+                                           [&](const field::Structure& st) {
+                                             return std::hypot(st.center_m.x - centre.x(),
+                                                               st.center_m.y - centre.y()) < half;
+                                           }),
+                            others.structures.end());
+    for (int k = 0; k < 12; ++k) {
+      const double heading = k * kPi / 6.0;
+      const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
+      const Eigen::Vector2d stage = centre - (reach + margin_m) * dir;
+      const Eigen::Vector2d release = centre - (reach + 0.01) * dir;
+      if (!context.is_clear(stage)) continue;
+      if (!platform::FootprintIsFree(others, platform::Pose2D{release.x(), release.y(), heading},
+                                     robot.length_m, robot.width_m)) {
+        continue;
+      }
+      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+    }
+    return out;
+  }
+  // A floor zone: drop points on a grid inside it, approached along the four axes.
+  const double inset = object_radius_m + 0.05;
+  const double yaw = g.yaw_deg * kPi / 180.0;
+  const double hx =
+      g.shape == field::SolidShape::kCylinder ? g.radius_m / std::sqrt(2.0) : g.size_m.x / 2.0;
+  const double hy =
+      g.shape == field::SolidShape::kCylinder ? g.radius_m / std::sqrt(2.0) : g.size_m.y / 2.0;
+  for (double lx = -hx + inset; lx <= hx - inset + 1e-9;
+       lx += std::max(0.3, (2 * hx - 2 * inset) / 4.0)) {
+    for (double ly = -hy + inset; ly <= hy - inset + 1e-9;
+         ly += std::max(0.3, (2 * hy - 2 * inset) / 6.0)) {
+      const Eigen::Vector2d drop =
+          centre + Eigen::Vector2d(std::cos(yaw) * lx - std::sin(yaw) * ly,
+                                   std::sin(yaw) * lx + std::cos(yaw) * ly);
+      for (int k = 0; k < 4; ++k) {
+        const double heading = k * kPi / 2.0;
+        const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
+        const Eigen::Vector2d stage =
+            drop - (ReleaseDistance(robot, object_radius_m) + margin_m) * dir;
+        const Eigen::Vector2d release = drop - ReleaseDistance(robot, object_radius_m) * dir;
+        if (!context.is_clear(stage)) continue;
+        // Nothing fixed between the robot and the drop (a zone behind a barrier is reached
+        // round it, not over it).
+        if (!platform::FootprintIsFree(*context.season,
+                                       platform::Pose2D{release.x(), release.y(), heading},
+                                       robot.length_m, robot.width_m)) {
+          continue;
+        }
+        bool blocked = false;
+        for (double f = 0.0; f <= 1.0 && !blocked; f += 0.05) {
+          blocked =
+              platform::PointInBlockingStructure(*context.season, stage + f * (drop - stage), 0.02);
+        }
+        if (!blocked) out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+      }
+    }
+  }
+  return out;
+}
+
+Eigen::Vector2d DropTarget(const field::SeasonConfig& season, const field::RobotConfig& robot,
+                           int goal_index, const Eigen::Vector3d& stage, double object_radius_m,
+                           double margin_m) {
+  const field::Goal& g = season.goals[goal_index];
+  if (g.kind == field::GoalKind::kGoal) return Eigen::Vector2d(g.center_m.x, g.center_m.y);
+  const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
+  return stage.head<2>() + (ReleaseDistance(robot, object_radius_m) + margin_m) * dir;
+}
+
+double SuccessProbability(const Eigen::Matrix2d& cov, double tolerance_m) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  const double sigma = std::sqrt(std::max(eig.eigenvalues().maxCoeff(), 1e-12));
+  return std::erf(tolerance_m / (sigma * std::sqrt(2.0)));
+}
+
+}  // namespace slamo::strategy

@@ -1,0 +1,49 @@
+// Travel times for the strategy from the planner's map: geodesic distances on the planner's
+// inflated grid (Dijkstra, 8-connected, on a coarser copy of the grid), turned into seconds
+// with the drive's turn rate, speed and acceleration (planning::DriveTime). One distance field
+// is computed per start cell and cached until the map changes, so the strategy can ask for
+// many targets at the cost of one search per start.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "field_configs/robot_config.h"
+#include "planning/planner.h"
+
+namespace slamo::strategy {
+
+class TravelField {
+ public:
+  // cell_m: edge of the coarse cells (a multiple of the planner's grid cell is best).
+  TravelField(const field::DriveConfig& drive, double cell_m = 0.04);
+
+  // Takes the planner's current inflated grid; drops the cached fields.
+  void SetPlanner(const planning::Planner& planner);
+
+  // Shortest collision-free distance between two points, or nothing when unreachable. A start
+  // inside the inflation (after a close approach) leaves through the nearest free cell.
+  std::optional<double> DistanceM(const Eigen::Vector2d& from, const Eigen::Vector2d& to);
+  // Turn towards the target, drive the geodesic distance, turn to the final heading; plus
+  // settle_s for each of the three motions.
+  std::optional<double> TravelTimeS(const Eigen::Vector3d& from, const Eigen::Vector3d& to);
+
+  double settle_s = 0.3;
+
+ private:
+  std::optional<int> CellOf(const Eigen::Vector2d& p) const;
+  const std::vector<float>& FieldFrom(int cell);
+
+  field::DriveConfig drive_;
+  double cell_m_;
+  int width_ = 0, height_ = 0;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  std::vector<std::uint8_t> blocked_;
+  std::unordered_map<int, std::vector<float>> fields_;
+};
+
+}  // namespace slamo::strategy

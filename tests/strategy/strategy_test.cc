@@ -1,0 +1,119 @@
+#include "strategy/strategy.h"
+
+#include <gtest/gtest.h>
+
+#include "field_configs/loader.h"
+#include "mapping/object_map.h"
+#include "planning/planner.h"
+#include "platform/sim_world.h"
+#include "strategy/travel_field.h"
+
+namespace slamo::strategy {
+namespace {
+
+class StrategyTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    season_ = field::LoadSeasonConfig("toss_up");
+    robot_ = field::LoadRobotConfig("thesis_robot");
+    map_ = std::make_unique<mapping::ObjectMap>(season_);
+    planner_ = std::make_unique<planning::Planner>(robot_);
+    planner_->SetMap(*map_);
+    travel_ = std::make_unique<TravelField>(robot_.drive);
+    travel_->SetPlanner(*planner_);
+    context_.season = &season_;
+    context_.robot = &robot_;
+    context_.alliance = field::Alliance::kRed;
+    context_.travel_time_s = [this](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      return travel_->TravelTimeS(a, b);
+    };
+    context_.is_clear = [this](const Eigen::Vector2d& p) { return planner_->IsClear(p); };
+  }
+  int Goal(const std::string& name) const {
+    for (size_t g = 0; g < season_.goals.size(); ++g) {
+      if (season_.goals[g].name == name) return static_cast<int>(g);
+    }
+    return -1;
+  }
+
+  field::SeasonConfig season_;
+  field::RobotConfig robot_;
+  std::unique_ptr<mapping::ObjectMap> map_;
+  std::unique_ptr<planning::Planner> planner_;
+  std::unique_ptr<TravelField> travel_;
+  StrategyContext context_;
+};
+
+TEST_F(StrategyTest, PointsFollowTheSeasonRules) {
+  EXPECT_EQ(GoalPoints(season_, Goal("red_stash"), "buckyball", "red", field::Alliance::kRed), 5);
+  EXPECT_EQ(GoalPoints(season_, Goal("red_stash"), "large_ball", "red", field::Alliance::kRed), 10);
+  EXPECT_EQ(GoalPoints(season_, Goal("blue_stash"), "buckyball", "red", field::Alliance::kRed), 0);
+  EXPECT_EQ(GoalPoints(season_, Goal("red_stash"), "buckyball", "blue", field::Alliance::kRed), 0);
+  EXPECT_EQ(
+      FloorPoints(season_, Eigen::Vector2d(-1.0, 0.0), "buckyball", "red", field::Alliance::kRed),
+      1);
+  EXPECT_EQ(
+      FloorPoints(season_, Eigen::Vector2d(1.2, 0.0), "large_ball", "red", field::Alliance::kRed),
+      5);
+}
+
+TEST_F(StrategyTest, SuccessProbabilityFallsWithUncertainty) {
+  const double sure = SuccessProbability(Eigen::Matrix2d::Identity() * 1e-4, 0.1);
+  const double unsure = SuccessProbability(Eigen::Matrix2d::Identity() * 0.25, 0.1);
+  EXPECT_GT(sure, 0.99);
+  EXPECT_LT(unsure, 0.2);
+  EXPECT_NEAR(SuccessProbability(Eigen::Matrix2d::Identity() * 0.01, 0.1), 0.6827,
+              1e-3);  // 1 sigma
+}
+
+TEST_F(StrategyTest, StashIsApproachedFromItsOpenSideOnly) {
+  const int stash = Goal("red_stash");
+  const std::vector<Eigen::Vector3d> stages = ScoreStages(context_, stash, 0.0635, 0.15);
+  ASSERT_FALSE(stages.empty());
+  for (const Eigen::Vector3d& s : stages) {
+    EXPECT_LT(s.x(), 0.45) << "the barrier is behind the stash";
+    EXPECT_TRUE(planner_->IsClear(s.head<2>()));
+    // Facing the stash's centre.
+    const Eigen::Vector2d to_goal = Eigen::Vector2d(0.45, 0.61) - s.head<2>();
+    EXPECT_NEAR(std::remainder(std::atan2(to_goal.y(), to_goal.x()) - s.z(), 2 * M_PI), 0.0, 1e-6);
+  }
+}
+
+TEST_F(StrategyTest, TravelTimesAreNeverShorterThanTheStraightLine) {
+  const Eigen::Vector3d from(-1.524, 0.3048, 0.0), to(-0.5, -1.0, 0.0);
+  const std::optional<double> d = travel_->DistanceM(from.head<2>(), to.head<2>());
+  ASSERT_TRUE(d);
+  EXPECT_GE(*d, (to - from).head<2>().norm() - 1e-9);
+  EXPECT_LT(*d, 1.15 * (to - from).head<2>().norm());
+  const std::optional<double> t = travel_->TravelTimeS(from, to);
+  ASSERT_TRUE(t);
+  EXPECT_GT(*t, planning::DriveTime(robot_.drive, *d));
+  // Inside a structure: unreachable.
+  EXPECT_FALSE(travel_->DistanceM(from.head<2>(), Eigen::Vector2d(0.45, 0.61)));
+}
+
+TEST_F(StrategyTest, PlannerScoresTheHeldObjectAndIdlesWhenNothingFits) {
+  std::unique_ptr<Strategy> planner = MakeStrategy("planner", StrategyOptions{});
+  Belief b;
+  b.pose = Eigen::Vector3d(-1.524, 0.3048, 0.0);
+  b.held =
+      ObjectBelief{-1, "buckyball", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
+  EXPECT_EQ(planner->Next(b, context_).kind, ActionKind::kObserve);  // the initial survey
+  const Action first = planner->Next(b, context_);
+  EXPECT_EQ(first.kind, ActionKind::kNavigate);
+  EXPECT_GE(first.goal_index, 0);
+  EXPECT_GT(first.expected_points, 0.0);
+  EXPECT_LE(first.expected_s, b.deadline_s);
+  // 0.2 s left: no cycle fits, nor a look (10 frames take 0.33 s).
+  b.now_s = b.deadline_s - 0.2;
+  EXPECT_EQ(planner->Next(b, context_).kind, ActionKind::kIdle);
+}
+
+TEST_F(StrategyTest, UnknownStrategyIsAnError) {
+  EXPECT_THROW(MakeStrategy("random", StrategyOptions{}), std::invalid_argument);
+  for (const std::string& name : StrategyNames())
+    EXPECT_EQ(MakeStrategy(name, StrategyOptions{})->name(), name);
+}
+
+}  // namespace
+}  // namespace slamo::strategy
