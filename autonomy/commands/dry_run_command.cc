@@ -1,6 +1,8 @@
 // `slamo dry-run`: one simulated autonomous period, end to end, with the report files. With no
 // arguments it runs the default season from its first red starting tile. Exit status: 0 after
 // a run (whatever it scored), 1 when an output file cannot be written, 2 on bad input.
+// `--from-recording DIR` runs SLAM-O on a recorded run instead (autonomy/recording_run.h).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,8 +14,10 @@
 #include "autonomy/commands/commands.h"
 #include "autonomy/executive.h"
 #include "autonomy/match_report.h"
+#include "autonomy/recording_run.h"
 #include "field_configs/loader.h"
 #include "mapping/frame_selection.h"
+#include "platform/recording.h"
 #include "strategy/strategy.h"
 
 namespace slamo::autonomy {
@@ -31,9 +35,59 @@ struct DryRunArgs {
   bool video = true;
   bool quiet = false;
   bool frames_png = false;
+  std::string recording;  // --from-recording: a TUM folder or rawlog instead of the simulator
 };
 
+// SLAM-O on a recording: report.json, map.png, trajectory.tum (+ groundtruth.tum when the
+// recording has ground truth) and objects.bt; no replay.
+int DryRunRecording(const DryRunArgs& args) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
+  const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  std::error_code ec;
+  std::filesystem::create_directories(args.out, ec);
+  if (ec) {
+    std::cerr << "error: " << args.out << ": " << ec.message() << "\n";
+    return 1;
+  }
+  std::cout << "dry run: " << season.name << " (" << season.season << ") on the recording "
+            << args.recording << "\n";
+  MatchResult result;
+  try {
+    result = RunRecording(season, robot, args.recording, RecordingRunOptions{}, args.out);
+  } catch (const platform::RecordingError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  const bool has_truth = !std::isnan(result.pose_ate_m);
+  PrintSummary(result, std::cout);
+  if (!has_truth)
+    std::cout << "  (the recording has no ground truth: pose ATE is not available and the "
+                 "truth columns repeat the estimate)\n";
+  const std::string dir = args.out + "/";
+  try {
+    {
+      std::ofstream report(dir + "report.json");
+      report << ReportJson(result).dump(2) << "\n";
+      if (!report) throw std::runtime_error("cannot write " + dir + "report.json");
+    }
+    WriteTum(result, dir + "trajectory.tum");
+    if (has_truth) WriteTruthTum(result, dir + "groundtruth.tum");
+    if (!cv::imwrite(dir + "map.png", DrawMatchMap(result)))
+      throw std::runtime_error("cannot write " + dir + "map.png");
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  std::cout << "wrote " << dir << "{report.json, map.png, trajectory.tum, "
+            << (has_truth ? "groundtruth.tum, " : "") << "objects.bt}\n";
+  return 0;
+}
+
 int DryRun(const DryRunArgs& args) {
+  if (!args.recording.empty()) return DryRunRecording(args);
   const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
   const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
   MatchSetup setup;
@@ -124,6 +178,9 @@ void RegisterDryRunCommand(CLI::App& app, CommandAction* action) {
       ->check(CLI::Range(0.0, 5.0));
   cmd->add_flag("!--no-video", args->video, "skip replay.avi");
   cmd->add_flag("--quiet", args->quiet, "no line per action");
+  cmd->add_option("--from-recording", args->recording,
+                  "run SLAM-O on a recording (TUM folder or rawlog, see `slamo record`) instead "
+                  "of the simulator");
   cmd->add_flag("--replay-png", args->frames_png,
                 "also write every replay frame as DIR/replay/NNNN.png");
   cmd->callback([args, action]() { *action = [args]() { return DryRun(*args); }; });

@@ -24,6 +24,19 @@ set +e
 set -e
 grep -q "cannot run a match yet" "$dir/match.txt"
 
+# SLAM-O on a recording: the report files; a folder that is no recording exits 2.
+"$slamo" record --sim --seed 1 --script "forward 0.3; turn 45" --format tum --out "$dir/rec" > /dev/null
+"$slamo" dry-run --from-recording "$dir/rec" --out "$dir/fromrec" > "$dir/fromrec.txt"
+for f in report.json map.png trajectory.tum groundtruth.tum objects.bt; do
+  test -s "$dir/fromrec/$f" || { echo "missing $dir/fromrec/$f"; exit 1; }
+done
+grep -q '"strategy": "recording"' "$dir/fromrec/report.json" || { echo "not a recording report"; exit 1; }
+set +e
+"$slamo" dry-run --from-recording "$dir/no_such_recording" --out "$dir/bad" > /dev/null 2> "$dir/fromrec_bad.txt"
+test $? -eq 2 || { echo "bad recording: not 2"; exit 1; }
+set -e
+grep -q "error: " "$dir/fromrec_bad.txt"
+
 # A small sweep on two processes, then the same as two shards merged: the same ranking.
 "$slamo" tune --matches 2 --param strategy=scripted,greedy --jobs 2 --out "$dir/tune" > "$dir/tune.txt" 2>/dev/null
 test -s "$dir/tune/tune.csv" && test -s "$dir/tune/tune.json"
