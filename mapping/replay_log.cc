@@ -23,6 +23,8 @@
 #include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include "platform/rawlog_guard.h"
+
 namespace slamo::mapping {
 namespace {
 
@@ -186,6 +188,9 @@ class RawlogReader {
 
   ReplayLog Read() {
     if (!std::ifstream(path_)) throw ReplayLogError(path_ + ": cannot open");
+    // A record that crashes or hangs MRPT's deserialiser does so in a child process.
+    if (const std::optional<std::string> crash = platform::CheckRawlogInChildProcess(path_))
+      throw ReplayLogError(path_ + ": " + *crash + ": not a rawlog slamo can read");
     mrpt::io::CFileGZInputStream file;
     try {
       if (!file.open(path_)) throw ReplayLogError(path_ + ": cannot open");

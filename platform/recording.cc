@@ -32,6 +32,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "platform/clock.h"
+#include "platform/rawlog_guard.h"
 #include "platform/sim_field.h"
 
 namespace slamo::platform {
@@ -715,6 +716,9 @@ class RawlogStream {
   explicit RawlogStream(const std::string& path) : path_(path) {
     std::error_code ec;
     if (!fs::is_regular_file(path_, ec)) throw RecordingError(path_ + ": no such file");
+    // A record that crashes or hangs MRPT's deserialiser does so in a child process.
+    if (const std::optional<std::string> crash = CheckRawlogInChildProcess(path_))
+      throw RecordingError(path_ + ": " + *crash + ": not a rawlog slamo can read");
     bool ok = false;
     try {
       ok = file_.open(path_);

@@ -316,5 +316,19 @@ TEST(RawlogTest, OtherFilesGiveAnErrorNotACrash) {
   EXPECT_THROW(ReadRawlog(TempPath("missing.rawlog")), ReplayLogError);
 }
 
+// A rawlog that crashes MRPT's own deserialiser (found by replay_rawlog_fuzzer): the crash
+// happens in a child process and reaches the caller as an error naming the record.
+TEST(RawlogTest, ARecordThatCrashesMrptGivesAnErrorNotACrash) {
+  const std::string known = std::string(SLAMO_SOURCE_DIR) +
+                            "/tests/fuzz/known_crashes/mrpt_action_robot_movement_2d_segv.rawlog";
+  ExpectRawlogError(known, "record 1");
+  try {
+    ReadRawlog(known);
+  } catch (const ReplayLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("MRPT's rawlog deserialiser"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace slamo::mapping

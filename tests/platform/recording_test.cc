@@ -468,6 +468,12 @@ TEST(RecordingTest, BadRawlogs) {
   WriteText(dir + "/cut.rawlog", whole.substr(0, whole.size() / 2));
   ExpectRecordingError([&] { OpenRawlogRecording(dir + "/cut.rawlog"); },
                        {dir + "/cut.rawlog", "record "});
+
+  // One that crashes MRPT's own deserialiser (tests/fuzz/known_crashes/): in a child process.
+  const std::string crash = std::string(SLAMO_SOURCE_DIR) +
+                            "/tests/fuzz/known_crashes/mrpt_action_robot_movement_2d_segv.rawlog";
+  ExpectRecordingError([&] { OpenRawlogRecording(crash); },
+                       {crash, "MRPT's rawlog deserialiser", "record 1"});
 }
 
 // ---- The simulator as the recorder ----

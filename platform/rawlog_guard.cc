@@ -1,0 +1,136 @@
+#include "platform/rawlog_guard.h"
+
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <new>
+
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/serialization/CArchive.h>
+
+#if defined(__SANITIZE_ADDRESS__)
+#define SLAMO_RAWLOG_GUARD_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SLAMO_RAWLOG_GUARD_ASAN 1
+#endif
+#endif
+
+namespace slamo::platform {
+namespace {
+
+// What one record may allocate in the child beyond what the process already maps: a record is
+// one observation (a 640x480 RGB-D frame is about 1.5 MB), so a request for more is a corrupt
+// size. (Not under AddressSanitizer, whose shadow memory fills the address space.)
+constexpr uint64_t kChildBudgetBytes = 1ull << 30;
+constexpr int kExitTooBig = 5;
+
+void LimitAddressSpace() {
+#ifndef SLAMO_RAWLOG_GUARD_ASAN
+  uint64_t pages = 0;
+  std::ifstream("/proc/self/statm") >> pages;
+  if (pages == 0) return;
+  const uint64_t limit = pages * static_cast<uint64_t>(::sysconf(_SC_PAGESIZE)) + kChildBudgetBytes;
+  rlimit current{};
+  if (::getrlimit(RLIMIT_AS, &current) != 0) return;
+  if (current.rlim_cur != RLIM_INFINITY && current.rlim_cur < limit) return;
+  const rlimit lowered{limit, current.rlim_max};
+  ::setrlimit(RLIMIT_AS, &lowered);
+#endif
+}
+
+// The child: reads to the end, telling the parent each record's number as it starts it.
+[[noreturn]] void ReadInChild(const std::string& path, int report_fd, unsigned timeout_s) {
+  // Quiet, and no sanitizer or crash handler of the parent's: a crash just ends the child.
+  const int devnull = ::open("/dev/null", O_WRONLY);
+  if (devnull >= 0) {
+    ::dup2(devnull, STDOUT_FILENO);
+    ::dup2(devnull, STDERR_FILENO);
+  }
+  for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+  ::alarm(timeout_s);
+  LimitAddressSpace();
+  try {
+    mrpt::io::CFileGZInputStream file;
+    if (!file.open(path)) ::_exit(3);
+    auto archive = mrpt::serialization::archiveFrom(file);
+    for (uint32_t record = 1;; ++record) {
+      if (::write(report_fd, &record, sizeof(record)) != sizeof(record)) ::_exit(4);
+      try {
+        archive.ReadObject();
+      } catch (const mrpt::serialization::CExceptionEOF&) {
+        ::_exit(0);
+      }
+    }
+  } catch (const std::bad_alloc&) {
+    ::_exit(kExitTooBig);
+  } catch (...) {
+    ::_exit(3);  // an error MRPT reports: the caller's reader names it
+  }
+}
+
+}  // namespace
+
+std::optional<std::string> CheckRawlogInChildProcess(const std::string& path, double timeout_s) {
+  int fds[2];
+  if (::pipe(fds) != 0) return std::nullopt;  // cannot isolate: read in-process as before
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return std::nullopt;
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    ReadInChild(path, fds[1], static_cast<unsigned>(timeout_s > 1.0 ? timeout_s : 1.0));
+  }
+  ::close(fds[1]);
+  uint32_t record = 0, got = 0;
+  for (;;) {
+    const ssize_t n = ::read(fds[0], &got, sizeof(got));
+    if (n == static_cast<ssize_t>(sizeof(got))) {
+      record = got;
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else {
+      break;  // the child closed the pipe (ended)
+    }
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return std::nullopt;
+  }
+  const std::string where = " reading record " + std::to_string(record);
+  if (WIFEXITED(status)) {
+    const int code = WEXITSTATUS(status);
+    if (code == 0 || code == 3) return std::nullopt;
+    if (code == kExitTooBig) {
+      return "a record asks MRPT's rawlog deserialiser for more than " +
+             std::to_string(kChildBudgetBytes >> 20) + " MiB (a corrupt size?)" + where;
+    }
+    return "MRPT's rawlog deserialiser ended the reading process (exit " + std::to_string(code) +
+           ")" + where;
+  }
+  if (WIFSIGNALED(status)) {
+    const int sig = WTERMSIG(status);
+    if (sig == SIGALRM) {
+      return "MRPT's rawlog deserialiser hung (more than " +
+             std::to_string(static_cast<int>(timeout_s)) + " s)" + where;
+    }
+    const char* name = sigabbrev_np(sig);
+    return std::string("MRPT's rawlog deserialiser crashed (SIG") + (name ? name : "?") + ")" +
+           where;
+  }
+  return std::nullopt;
+}
+
+}  // namespace slamo::platform
