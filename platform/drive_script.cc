@@ -71,18 +71,19 @@ DriveStep ParseStatement(int index, const std::string& statement) {
   return step;
 }
 
-// The controller: runs in lockstep with the simulator and sees only its encoders.
+// The controller: sees only the encoders. `advance` lets one control period pass on the clock
+// (the simulator steps; on hardware the link is serviced while real time runs).
 class Runner {
  public:
-  Runner(const DriveControllerOptions& options, SimDriveBase* sim, SimClock* clock,
-         std::function<void(double)> advance)
+  Runner(const DriveControllerOptions& options, const DriveBodyLink& body)
       : options_(options),
-        sim_(sim),
-        clock_(clock),
-        advance_(advance ? std::move(advance) : [sim](double dt_s) { sim->Step(dt_s); }),
-        half_track_m_(0.5 * sim->drive().track_width_m),
-        odometry_(sim->metres_per_tick(), sim->drive().track_width_m, sim->ReadEncoders(),
-                  sim->odometry_pose()),
+        base_(body.base),
+        clock_(body.clock),
+        advance_(body.advance),
+        truth_(body.truth),
+        half_track_m_(0.5 * body.track_width_m),
+        odometry_(body.metres_per_tick, body.track_width_m, body.base->ReadEncoders(),
+                  body.odometry_start),
         heading_rad_(odometry_.pose().theta_rad),
         intended_heading_rad_(heading_rad_) {}
 
@@ -91,11 +92,9 @@ class Runner {
     result.step = step;
     bool done = true;
     if (clock_->NowS() >= options_.hard_deadline_s) {
-      sim_->Stop();
+      base_->Stop();
       result.status = DriveStepStatus::kDeadline;
-      result.end_time_s = clock_->NowS();
-      result.true_pose = sim_->true_pose();
-      result.odometry_pose = odometry_.pose();
+      Finish(&result);
       return result;
     }
     switch (step.kind) {
@@ -112,7 +111,7 @@ class Runner {
         break;
       }
       case DriveStepKind::kWait: {
-        sim_->Stop();
+        base_->Stop();
         const long ticks = std::lround(step.amount / options_.control_dt_s);
         long i = 0;
         for (; i < ticks && clock_->NowS() < options_.hard_deadline_s; ++i) Tick();
@@ -123,24 +122,28 @@ class Runner {
     result.status = done                                         ? DriveStepStatus::kDone
                     : clock_->NowS() >= options_.hard_deadline_s ? DriveStepStatus::kDeadline
                                                                  : DriveStepStatus::kTimedOut;
-    result.end_time_s = clock_->NowS();
-    result.true_pose = sim_->true_pose();
-    result.odometry_pose = odometry_.pose();
+    Finish(&result);
     return result;
   }
 
  private:
+  void Finish(DriveStepResult* result) const {
+    result->end_time_s = clock_->NowS();
+    result->odometry_pose = odometry_.pose();
+    result->truth_known = static_cast<bool>(truth_);
+    result->true_pose = truth_ ? truth_() : odometry_.pose();
+  }
+
   double Deadline(double nominal_s) const {
     return std::min(options_.hard_deadline_s, clock_->NowS() + options_.timeout_factor * nominal_s +
                                                   options_.timeout_margin_s);
   }
 
-  // One controller period: simulator and clock advance together, then the encoders are read.
+  // One controller period passes, then the encoders are read.
   void Tick() {
     advance_(options_.control_dt_s);
-    clock_->Advance(options_.control_dt_s);
     const double before_rad = odometry_.pose().theta_rad;
-    odometry_.Update(sim_->ReadEncoders());
+    odometry_.Update(base_->ReadEncoders());
     heading_rad_ += WrapAngleRad(odometry_.pose().theta_rad - before_rad);
   }
 
@@ -165,7 +168,7 @@ class Runner {
         return false;
       }
       speed_mps = RampSpeed(speed_mps, remaining_m);
-      sim_->SetSpeedTargets(-sign * speed_mps, sign * speed_mps);
+      base_->SetSpeedTargets(-sign * speed_mps, sign * speed_mps);
       Tick();
     }
     Settle();
@@ -199,7 +202,7 @@ class Runner {
           options_.heading_gain_per_s * (intended_heading_rad_ - heading_rad_);
       const double steer_mps =
           std::clamp(yaw_rate_rps * half_track_m_, -0.5 * speed_mps, 0.5 * speed_mps);
-      sim_->SetSpeedTargets(sign * speed_mps - steer_mps, sign * speed_mps + steer_mps);
+      base_->SetSpeedTargets(sign * speed_mps - steer_mps, sign * speed_mps + steer_mps);
       Tick();
     }
     Settle();
@@ -208,7 +211,7 @@ class Runner {
 
   // Stops and waits until the encoders have been still for settle_s (or max_settle_s).
   void Settle() {
-    sim_->Stop();
+    base_->Stop();
     double still_s = 0.0;
     for (double waited_s = 0.0; still_s < options_.settle_s && waited_s < options_.max_settle_s;
          waited_s += options_.control_dt_s) {
@@ -221,9 +224,10 @@ class Runner {
   }
 
   DriveControllerOptions options_;
-  SimDriveBase* sim_;
-  SimClock* clock_;
-  std::function<void(double)> advance_;  // steps the simulator (and whatever it lives in)
+  DriveBase* base_;
+  const Clock* clock_;
+  std::function<void(double)> advance_;
+  std::function<Pose2D()> truth_;
   double half_track_m_;
   EncoderOdometry odometry_;
   double heading_rad_;           // odometry heading, unwrapped
@@ -262,13 +266,40 @@ DriveControllerOptions DriveControllerOptionsFor(const field::DriveConfig& drive
 
 std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
                                             const DriveControllerOptions& options,
-                                            SimDriveBase* sim, SimClock* clock,
-                                            std::function<void(double)> advance) {
-  Runner runner(options, sim, clock, std::move(advance));
+                                            const DriveBodyLink& body) {
+  if (body.base == nullptr || body.clock == nullptr || !body.advance ||
+      body.metres_per_tick <= 0.0 || body.track_width_m <= 0.0) {
+    throw std::invalid_argument(
+        "RunDriveScript: a drive base, a clock, an advance function and a positive wheel geometry "
+        "are needed");
+  }
+  Runner runner(options, body);
   std::vector<DriveStepResult> results;
   results.reserve(steps.size());
   for (const DriveStep& step : steps) results.push_back(runner.Run(step));
   return results;
+}
+
+std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
+                                            const DriveControllerOptions& options,
+                                            SimDriveBase* sim, SimClock* clock,
+                                            std::function<void(double)> advance) {
+  DriveBodyLink body;
+  body.base = sim;
+  body.metres_per_tick = sim->metres_per_tick();
+  body.track_width_m = sim->drive().track_width_m;
+  body.odometry_start = sim->odometry_pose();
+  body.clock = clock;
+  body.advance = [sim, clock, step = std::move(advance)](double dt_s) {
+    if (step) {
+      step(dt_s);
+    } else {
+      sim->Step(dt_s);
+    }
+    clock->Advance(dt_s);
+  };
+  body.truth = [sim]() { return sim->true_pose(); };
+  return RunDriveScript(steps, options, body);
 }
 
 std::vector<DriveStepResult> SimulateDriveScript(const std::string& script,

@@ -72,9 +72,30 @@ struct DriveStepResult {
   DriveStep step;
   DriveStepStatus status = DriveStepStatus::kDone;
   double end_time_s = 0.0;
-  Pose2D true_pose;      // ground truth from the simulator
-  Pose2D odometry_pose;  // what the encoders say (the controller's dead reckoning)
+  Pose2D true_pose;         // ground truth from the simulator (the odometry when unknown)
+  bool truth_known = true;  // false on hardware
+  Pose2D odometry_pose;     // what the encoders say (the controller's dead reckoning)
 };
+
+// What the controller drives: any DriveBase (the simulator's, the serial link to the board),
+// its wheel geometry, the clock, and how time passes. `advance(dt_s)` must let dt_s pass on
+// `clock` (step the simulator and advance a SimClock; or service the link until a real clock
+// has moved on). `truth`, when known (the simulator), fills DriveStepResult::true_pose.
+struct DriveBodyLink {
+  DriveBase* base = nullptr;
+  double metres_per_tick = 0.0;
+  double track_width_m = 0.0;
+  Pose2D odometry_start;  // the dead reckoning's start (only headings matter to the controller)
+  const Clock* clock = nullptr;
+  std::function<void(double)> advance;
+  std::function<Pose2D()> truth;
+};
+
+// Drives `steps` on `body`. Throws std::invalid_argument for a link without a base, clock or
+// advance function, or without a wheel geometry.
+std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
+                                            const DriveControllerOptions& options,
+                                            const DriveBodyLink& body);
 
 // Drives `steps` on `sim`, advancing `clock` in lockstep with it. Headings are tracked
 // against the intended heading, so a turn also corrects the previous turn's encoder error.
