@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "strategy/strategy.h"
@@ -28,7 +29,11 @@ std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
     r.estimate_m = o.position_m;
     r.covariance = o.covariance;
     double best = 0.5;
-    for (const platform::SimObject& t : world.sim().world().objects) {
+    if (world.sim() == nullptr) {  // no truth on hardware
+      out.push_back(r);
+      continue;
+    }
+    for (const platform::SimObject& t : world.sim()->world().objects) {
       if (t.held || t.type->name != o.kind || t.colour != o.colour) continue;
       const double e = (t.center_m.head<2>() - o.position_m).norm();
       if (e < best) best = e, r.matched = true, r.truth_m = t.center_m.head<2>(), r.error_m = e;
@@ -47,26 +52,64 @@ MatchResult RunMatch(const field::SeasonConfig& season, const field::RobotConfig
                       setup, seed, out_dir, progress);
 }
 
+namespace {
+
+// The thesis baseline is the thesis's rule: a fixed count of frames at every stop.
+MatchSetup SetupFor(const strategy::Strategy& strategy, const MatchSetup& setup) {
+  MatchSetup out = setup;
+  if (strategy.name() == "thesis") {
+    out.frames.rule = mapping::FrameRule::kFixed;
+    out.frames.fixed_frames = setup.strategy_options.thesis_frames;
+  }
+  return out;
+}
+
+MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& world,
+                    const field::SeasonConfig& season, const MatchSetup& match_setup, uint64_t seed,
+                    const std::string& out_dir,
+                    const std::function<void(const TimelineEntry&)>& progress,
+                    std::chrono::steady_clock::time_point wall_start);
+
+}  // namespace
+
 MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
                          const field::SeasonConfig& season, const field::RobotConfig& robot,
                          const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
                          const std::function<void(const TimelineEntry&)>& progress) {
   const auto wall_start = std::chrono::steady_clock::now();
-  MatchSetup match_setup = setup;
-  // The thesis baseline is the thesis's rule: a fixed count of frames at every stop.
-  if (strategy->name() == "thesis") {
-    match_setup.frames.rule = mapping::FrameRule::kFixed;
-    match_setup.frames.fixed_frames = setup.strategy_options.thesis_frames;
-  }
+  const MatchSetup match_setup = SetupFor(*strategy, setup);
   MatchWorld world(season, robot, match_setup, seed, strategy->perceives());
+  return RunLoop(std::move(strategy), world, season, match_setup, seed, out_dir, progress,
+                 wall_start);
+}
 
+MatchResult RunMatchOn(std::unique_ptr<RobotIo> io, std::unique_ptr<strategy::Strategy> strategy,
+                       const field::SeasonConfig& season, const field::RobotConfig& robot,
+                       const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
+                       const std::function<void(const TimelineEntry&)>& progress) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const MatchSetup match_setup = SetupFor(*strategy, setup);
+  MatchWorld world(std::move(io), season, robot, match_setup, seed, strategy->perceives());
+  return RunLoop(std::move(strategy), world, season, match_setup, seed, out_dir, progress,
+                 wall_start);
+}
+
+namespace {
+
+MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& world,
+                    const field::SeasonConfig& season, const MatchSetup& match_setup, uint64_t seed,
+                    const std::string& out_dir,
+                    const std::function<void(const TimelineEntry&)>& progress,
+                    std::chrono::steady_clock::time_point wall_start) {
   MatchResult result;
   result.season = season.season;
   result.seed = seed;
   result.strategy = strategy->name();
   result.frames = mapping::Describe(match_setup.frames);
   result.deadline_s = world.deadline_s();
-  result.points_start = world.Points();
+  result.robot_io = world.io().Describe();
+  result.truth_known = world.sim() != nullptr;
+  result.points_start = world.Points().value_or(0);
 
   int idle_actions = 0;  // actions that took no time: a strategy going round in circles
   while (world.time_left_s() > 0.0) {
@@ -156,13 +199,18 @@ MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
   }
 
   // The report: points, timing, and SLAM-O against the simulator's truth.
-  result.points = world.Points();
+  result.points = world.Points().value_or(0);
   result.overrun_s = world.overrun_s();
   result.duration_s = std::min(world.last_motion_s(), world.deadline_s() + result.overrun_s);
   double sum_sq = 0.0;
-  for (const PoseSample& s : world.samples())
+  int with_truth = 0;
+  for (const PoseSample& s : world.samples()) {
+    if (!s.truth_known) continue;
     sum_sq += (s.estimate - s.truth).head<2>().squaredNorm();
-  result.pose_ate_m = world.samples().empty() ? 0.0 : std::sqrt(sum_sq / world.samples().size());
+    ++with_truth;
+  }
+  result.pose_ate_m =
+      with_truth == 0 ? std::numeric_limits<double>::quiet_NaN() : std::sqrt(sum_sq / with_truth);
   result.frames_taken = world.frames();
   result.replans = world.replans();
   result.relocalisations = world.relocalisations();
@@ -173,6 +221,7 @@ MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
   result.snapshots = world.snapshots();
   result.paths = world.paths();
   result.landmark_truth = world.landmark_truth();
+  result.board = world.io().Status();
   for (int i = 0; i < world.ekf().landmark_count(); ++i) {
     result.landmark_estimates.push_back(world.ekf().landmark(i));
     result.landmark_covariances.push_back(world.ekf().landmark_covariance(i));
@@ -184,4 +233,5 @@ MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
   return result;
 }
 
+}  // namespace
 }  // namespace slamo::autonomy

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,6 +39,9 @@ struct ObjectReport {
 };
 
 struct MatchResult {
+  std::string robot_io;                 // what the match ran on (RobotIo::Describe)
+  bool truth_known = true;              // false on hardware: points and object errors are unknown
+  std::map<std::string, double> board;  // hardware counters (RobotIo::Status)
   std::string season;
   uint64_t seed = 0;
   std::string strategy;
@@ -48,7 +52,8 @@ struct MatchResult {
   double duration_s = 0.0;  // until the last motion command (never after the deadline)
   double overrun_s = 0.0;   // motors driven after the deadline (goal: 0)
   int refused = 0;          // actions not started because they could not finish in time
-  double pose_ate_m = 0.0;  // RMS position error of the estimate at every filter update
+  double pose_ate_m = 0.0;  // RMS position error of the estimate at every filter update (NaN:
+                            // no truth)
   double observe_s = 0.0, drive_s = 0.0, score_s = 0.0, idle_s = 0.0;
   int frames_taken = 0;
   int replans = 0;
@@ -76,5 +81,13 @@ MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
                          const field::SeasonConfig& season, const field::RobotConfig& robot,
                          const MatchSetup& setup, uint64_t seed, const std::string& out_dir = "",
                          const std::function<void(const TimelineEntry&)>& progress = {});
+
+// One autonomous period on `io` (the robot: autonomy/hardware_io.h), with the season's objects
+// where its file puts them; `seed` seeds the planners. Truth-based figures (points, ATE,
+// object errors) are reported only when `io` knows the truth.
+MatchResult RunMatchOn(std::unique_ptr<RobotIo> io, std::unique_ptr<strategy::Strategy> strategy,
+                       const field::SeasonConfig& season, const field::RobotConfig& robot,
+                       const MatchSetup& setup, uint64_t seed, const std::string& out_dir = "",
+                       const std::function<void(const TimelineEntry&)>& progress = {});
 
 }  // namespace slamo::autonomy

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -84,14 +85,27 @@ nlohmann::json ReportJson(const MatchResult& r) {
   j["seed"] = r.seed;
   j["strategy"] = r.strategy;
   j["frames"] = r.frames;
-  j["points"] = r.points;
-  j["points_start"] = r.points_start;
-  j["points_gained"] = r.points - r.points_start;
+  j["robot_io"] = r.robot_io;
+  j["truth_known"] = r.truth_known;
+  if (r.truth_known) {
+    j["points"] = r.points;
+    j["points_start"] = r.points_start;
+    j["points_gained"] = r.points - r.points_start;
+  } else {  // no referee on hardware
+    j["points"] = nullptr;
+    j["points_start"] = nullptr;
+    j["points_gained"] = nullptr;
+  }
   j["duration_s"] = r.duration_s;
   j["deadline_s"] = r.deadline_s;
   j["overrun_s"] = r.overrun_s;
   j["refused_actions"] = r.refused;
-  j["pose_ate_m"] = r.pose_ate_m;
+  if (std::isnan(r.pose_ate_m)) {
+    j["pose_ate_m"] = nullptr;
+  } else {
+    j["pose_ate_m"] = r.pose_ate_m;
+  }
+  if (!r.board.empty()) j["board"] = r.board;
   j["seconds"] = {{"observe", r.observe_s},
                   {"drive", r.drive_s},
                   {"pick_score", r.score_s},
@@ -186,8 +200,9 @@ cv::Mat DrawMatchMap(const MatchResult& r) {
   for (size_t i = 1; i < r.snapshots.size(); ++i) {
     const Snapshot& a = r.snapshots[i - 1];
     const Snapshot& b = r.snapshots[i];
-    cv::line(image, canvas.ToPixel(a.truth.x_m, a.truth.y_m),
-             canvas.ToPixel(b.truth.x_m, b.truth.y_m), kTruth, 2, cv::LINE_AA);
+    if (a.truth_known && b.truth_known)
+      cv::line(image, canvas.ToPixel(a.truth.x_m, a.truth.y_m),
+               canvas.ToPixel(b.truth.x_m, b.truth.y_m), kTruth, 2, cv::LINE_AA);
     cv::line(image, canvas.ToPixel(a.estimate.x(), a.estimate.y()),
              canvas.ToPixel(b.estimate.x(), b.estimate.y()), kEstimate, 2, cv::LINE_AA);
   }
@@ -204,16 +219,22 @@ cv::Mat DrawMatchMap(const MatchResult& r) {
     Text(image, text, cv::Point(x, y += 22), 0.45, colour);
   };
   line(r.season + "  seed " + std::to_string(r.seed) + "  strategy " + r.strategy);
-  line("points " + std::to_string(r.points) + " (start " + std::to_string(r.points_start) + ", +" +
-       std::to_string(r.points - r.points_start) + ")");
+  if (r.truth_known) {
+    line("points " + std::to_string(r.points) + " (start " + std::to_string(r.points_start) +
+         ", +" + std::to_string(r.points - r.points_start) + ")");
+  } else {
+    line("on " + r.robot_io.substr(0, 40));
+    line("points unknown (no referee off the simulator)");
+  }
   line("deadline " + Fixed(r.deadline_s, 0) + " s, last motion " + Fixed(r.duration_s, 1) + " s");
   line("overrun " + Fixed(r.overrun_s, 2) + " s, refused actions " + std::to_string(r.refused));
-  line("pose ATE " + Fixed(r.pose_ate_m * 100, 1) + " cm over " + std::to_string(r.samples.size()) +
-       " updates");
+  if (!std::isnan(r.pose_ate_m))
+    line("pose ATE " + Fixed(r.pose_ate_m * 100, 1) + " cm over " +
+         std::to_string(r.samples.size()) + " updates");
   line("observe " + Fixed(r.observe_s, 1) + " s, drive " + Fixed(r.drive_s, 1) + " s,");
   line("  pick/score " + Fixed(r.score_s, 1) + " s, idle " + Fixed(r.idle_s, 1) + " s");
   y += 12;
-  line("true trajectory", kTruth);
+  if (!std::isnan(r.pose_ate_m)) line("true trajectory", kTruth);
   line("estimated trajectory, 3-sigma ellipses", kEstimate);
   line("planned paths", kPath);
   line("objects: circles truth at the end,");
@@ -239,14 +260,16 @@ cv::Mat DrawSnapshot(const MatchResult& r, size_t k) {
   for (size_t i = 1; i <= k; ++i) {
     const Snapshot& a = r.snapshots[i - 1];
     const Snapshot& b = r.snapshots[i];
-    cv::line(image, canvas.ToPixel(a.truth.x_m, a.truth.y_m),
-             canvas.ToPixel(b.truth.x_m, b.truth.y_m), kTruth, 1, cv::LINE_AA);
+    if (a.truth_known && b.truth_known)
+      cv::line(image, canvas.ToPixel(a.truth.x_m, a.truth.y_m),
+               canvas.ToPixel(b.truth.x_m, b.truth.y_m), kTruth, 1, cv::LINE_AA);
     cv::line(image, canvas.ToPixel(a.estimate.x(), a.estimate.y()),
              canvas.ToPixel(b.estimate.x(), b.estimate.y()), kEstimate, 1, cv::LINE_AA);
   }
   const double length = 0.45, width = 0.42;
-  Robot(canvas, Eigen::Vector3d(s.truth.x_m, s.truth.y_m, s.truth.theta_rad), nullptr, length,
-        width, kTruth, 2);
+  if (s.truth_known)
+    Robot(canvas, Eigen::Vector3d(s.truth.x_m, s.truth.y_m, s.truth.theta_rad), nullptr, length,
+          width, kTruth, 2);
   Robot(canvas, s.estimate, nullptr, length, width, kEstimate, 1);
   const cv::Point origin = canvas.ToPixel(r.field.HalfSize(), r.field.HalfSize());
   int x = origin.x + 30, y = origin.y + 10;
@@ -254,7 +277,8 @@ cv::Mat DrawSnapshot(const MatchResult& r, size_t k) {
        cv::Point(x, y += 22));
   Text(image, "t = " + Fixed(s.t_s, 2) + " / " + Fixed(r.deadline_s, 0) + " s",
        cv::Point(x, y += 22), 0.6);
-  Text(image, "points " + std::to_string(s.points), cv::Point(x, y += 22), 0.6);
+  Text(image, s.truth_known ? "points " + std::to_string(s.points) : "points unknown",
+       cv::Point(x, y += 22), 0.6);
   std::string action = s.action;
   while (!action.empty()) {
     Text(image, action.substr(0, 38), cv::Point(x, y += 20), 0.45);
@@ -280,25 +304,40 @@ int WriteReplay(const MatchResult& r, const std::string& path, double speedup) {
 void PrintSummary(const MatchResult& r, std::ostream& out) {
   out << r.season << ", seed " << r.seed << ", strategy " << r.strategy << ", frames " << r.frames
       << "\n";
-  out << "  points          " << r.points << " (" << r.points_start << " at the start, +"
-      << r.points - r.points_start << ")\n";
+  if (!r.robot_io.empty()) out << "  ran on          " << r.robot_io << "\n";
+  if (r.truth_known) {
+    out << "  points          " << r.points << " (" << r.points_start << " at the start, +"
+        << r.points - r.points_start << ")\n";
+  } else {
+    out << "  points          unknown (no referee off the simulator)\n";
+  }
   out << "  deadline        " << Fixed(r.deadline_s, 0) << " s; last motion at "
       << Fixed(r.duration_s, 2) << " s; overrun " << Fixed(r.overrun_s, 2) << " s; refused actions "
       << r.refused << "\n";
   out << "  time            observe " << Fixed(r.observe_s, 1) << " s, drive "
       << Fixed(r.drive_s, 1) << " s, pick/score " << Fixed(r.score_s, 1) << " s, idle "
       << Fixed(r.idle_s, 1) << " s\n";
-  out << "  pose ATE        " << Fixed(r.pose_ate_m, 4) << " m (" << r.samples.size()
-      << " filter updates, " << r.frames_taken << " frames, " << r.replans << " replans, "
-      << r.relocalisations << " relocalisations)\n";
+  out << "  pose ATE        "
+      << (std::isnan(r.pose_ate_m) ? std::string("unknown") : Fixed(r.pose_ate_m, 4) + " m") << " ("
+      << r.samples.size() << " filter updates, " << r.frames_taken << " frames, " << r.replans
+      << " replans, " << r.relocalisations << " relocalisations)\n";
   int matched = 0;
   double sum = 0.0;
   for (const ObjectReport& o : r.objects) {
     if (o.matched) ++matched, sum += o.error_m * o.error_m;
   }
-  out << "  objects mapped  " << r.objects.size() << " (" << matched << " matched to truth";
-  if (matched) out << ", RMS error " << Fixed(std::sqrt(sum / matched), 3) << " m";
-  out << ")\n";
+  out << "  objects mapped  " << r.objects.size();
+  if (r.truth_known) {
+    out << " (" << matched << " matched to truth";
+    if (matched) out << ", RMS error " << Fixed(std::sqrt(sum / matched), 3) << " m";
+    out << ")";
+  }
+  out << "\n";
+  if (!r.board.empty()) {
+    out << "  board, camera  ";
+    for (const auto& [key, value] : r.board) out << " " << key << " " << Fixed(value, 0);
+    out << "\n";
+  }
   out << "  computed in     " << Fixed(r.wall_s, 2) << " s ("
       << Fixed(r.deadline_s / std::max(r.wall_s, 1e-6), 1) << "x real time)\n";
   out << "  timeline:\n";
@@ -307,6 +346,28 @@ void PrintSummary(const MatchResult& r, std::ostream& out) {
         << Fixed(t.end_s, 2) << std::right << " " << std::setw(9) << std::left << t.action
         << std::right << (t.ok ? "   " : " x ") << t.detail << "\n";
   }
+}
+
+std::vector<std::string> WriteMatchFiles(const MatchResult& r, const std::string& dir, bool video) {
+  const std::string prefix = dir.empty() || dir.back() == '/' ? dir : dir + "/";
+  std::vector<std::string> written;
+  {
+    std::ofstream report(prefix + "report.json");
+    report << ReportJson(r).dump(2) << "\n";
+    if (!report) throw std::runtime_error("cannot write " + prefix + "report.json");
+    written.push_back("report.json");
+  }
+  WriteTum(r, prefix + "trajectory.tum");
+  written.push_back("trajectory.tum");
+  if (!std::isnan(r.pose_ate_m)) {
+    WriteTruthTum(r, prefix + "groundtruth.tum");
+    written.push_back("groundtruth.tum");
+  }
+  if (!cv::imwrite(prefix + "map.png", DrawMatchMap(r)))
+    throw std::runtime_error("cannot write " + prefix + "map.png");
+  written.push_back("map.png");
+  if (video && WriteReplay(r, prefix + "replay.avi") > 0) written.push_back("replay.avi");
+  return written;
 }
 
 }  // namespace slamo::autonomy

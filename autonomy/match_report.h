@@ -4,6 +4,7 @@
 
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -33,5 +34,18 @@ cv::Mat DrawSnapshot(const MatchResult& result, size_t k);
 int WriteReplay(const MatchResult& result, const std::string& path, double speedup = 4.0);
 
 void PrintSummary(const MatchResult& result, std::ostream& out);
+
+// report.json, trajectory.tum, map.png, and (when the truth is known) groundtruth.tum, and
+// (when `video`) replay.avi into dir. Returns the names written; throws std::runtime_error
+// naming a file that cannot be written.
+std::vector<std::string> WriteMatchFiles(const MatchResult& result, const std::string& dir,
+                                         bool video);
+
+// "a, b, c".
+inline std::string Join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
 
 }  // namespace slamo::autonomy

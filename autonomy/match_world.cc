@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include "platform/sim_renderer.h"
 #include "platform/sim_world.h"
 
 namespace slamo::autonomy {
@@ -65,24 +66,41 @@ field::RobotConfig MatchRobot(const field::RobotConfig& robot, double speed_mps)
   return out;
 }
 
-// What a team measures before it trusts its encoders: drive 1 m straight a few times on an
-// empty floor and compare the true distance (a tape measure) with what the encoders say. The
-// mean ratio scales every commanded distance and every odometry increment; SLAM-O is left the
-// random part of the slip.
-double CalibrateOdometryScale(const field::RobotConfig& robot) {
-  double ratio = 0.0;
-  const int runs = 5;
-  for (int i = 0; i < runs; ++i) {
-    const std::vector<platform::DriveStepResult> r =
-        platform::SimulateDriveScript("forward 1.0", robot, platform::SimDriveOptions{}, 1000 + i);
-    const double truth = std::hypot(r.back().true_pose.x_m, r.back().true_pose.y_m);
-    const double encoders = std::hypot(r.back().odometry_pose.x_m, r.back().odometry_pose.y_m);
-    ratio += truth / encoders;
-  }
-  return ratio / runs;
+}  // namespace
+
+std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field) {
+  std::vector<Eigen::Vector2d> out;
+  for (const field::Landmark& l : field.landmarks)
+    out.push_back(platform::LandmarkCentre(field, l).head<2>());
+  return out;
 }
 
-}  // namespace
+std::vector<int> MarkerIds(const field::SeasonConfig& field) {
+  std::vector<int> marker_id(field.landmarks.size(), -1);
+  for (size_t i = 0; i < field.landmarks.size(); ++i) {
+    const auto same = std::count_if(
+        field.landmarks.begin(), field.landmarks.end(),
+        [&](const field::Landmark& l) { return l.colour == field.landmarks[i].colour; });
+    if (same == 1) marker_id[i] = static_cast<int>(i);
+  }
+  return marker_id;
+}
+
+std::vector<int> AddSurveyedMarkers(const field::SeasonConfig& field, mapping::EkfSlam* ekf) {
+  const std::vector<Eigen::Vector2d> markers = SurveyedMarkers(field);
+  const std::vector<int> marker_id = MarkerIds(field);
+  for (size_t i = 0; i < field.landmarks.size(); ++i) {
+    ekf->AddKnownLandmark(markers[i], Eigen::Matrix2d::Identity() * 1e-6, marker_id[i],
+                          field.landmarks[i].colour);
+  }
+  return marker_id;
+}
+
+platform::Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance,
+                           int start_index) {
+  const field::StartTile& start = StartFor(season, alliance, start_index);
+  return {start.center_m.x, start.center_m.y, start.heading_deg * kPi / 180.0};
+}
 
 field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m,
                                  uint64_t seed) {
@@ -114,24 +132,26 @@ field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitte
 
 MatchWorld::MatchWorld(const field::SeasonConfig& season, const field::RobotConfig& robot,
                        const MatchSetup& setup, uint64_t seed, bool perceive)
-    : field_(PlaceObjects(season, setup.placement_jitter_m, seed)),
+    : MatchWorld(MakeSimIo(setup.alliance, seed),
+                 PlaceObjects(season, setup.placement_jitter_m, seed), robot, setup, seed,
+                 perceive) {}
+
+MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& season,
+                       const field::RobotConfig& robot, const MatchSetup& setup, uint64_t seed,
+                       bool perceive)
+    : field_(season),
       robot_(MatchRobot(robot, setup.drive_speed_mps)),
       setup_(setup),
       perceive_(perceive),
       deadline_s_(season.rules.autonomous_s),
+      io_(std::move(io)),
       ekf_(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-6),
       object_map_(field_),
       obstacle_map_(field_),
-      gyro_(seed),
       travel_(robot_.drive) {
-  const field::StartTile& start = StartFor(field_, setup.alliance, setup.start_index);
-  const Pose2D start_pose{start.center_m.x, start.center_m.y, start.heading_deg * kPi / 180.0};
-  platform::SimFieldOptions sim_options;
-  sim_options.preload = true;
-  sim_ = std::make_unique<platform::SimField>(field_, robot_, setup.alliance, seed, start_pose,
-                                              platform::SimDriveOptions{}, sim_options);
-  renderer_ = std::make_unique<platform::SimRenderer>(field_, robot_.camera,
-                                                      platform::RenderOptions{}, seed);
+  const Pose2D start_pose = StartPose(field_, setup.alliance, setup.start_index);
+  io_->Start(field_, robot_, start_pose);
+  markers_ = SurveyedMarkers(field_);
   landmark_detector_ = vision::LandmarkDetectorSetup(field_, &robot_.camera);
   object_detector_ = vision::ObjectDetectorSetup(field_, &robot_.camera);
   // The starting tile is known to a centimetre and a degree.
@@ -140,32 +160,26 @@ MatchWorld::MatchWorld(const field::SeasonConfig& season, const field::RobotConf
   ekf_ = mapping::EkfSlam(Eigen::Vector3d(start_pose.x_m, start_pose.y_m, start_pose.theta_rad),
                           Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal(),
                           ekf_options);
-  // The team surveys the markers it puts on the perimeter: they enter the filter as known
-  // landmarks; a colour shared by several is associated by position (JCBB).
-  marker_id_.assign(field_.landmarks.size(), -1);
-  for (size_t i = 0; i < field_.landmarks.size(); ++i) {
-    const auto same = std::count_if(
-        field_.landmarks.begin(), field_.landmarks.end(),
-        [&](const field::Landmark& l) { return l.colour == field_.landmarks[i].colour; });
-    if (same == 1) marker_id_[i] = static_cast<int>(i);
-    ekf_.AddKnownLandmark(renderer_->landmark_centres()[i].head<2>(),
-                          Eigen::Matrix2d::Identity() * 1e-6, marker_id_[i],
-                          field_.landmarks[i].colour);
-  }
+  marker_id_ = AddSurveyedMarkers(field_, &ekf_);
   // The preload: loaded by hand, so its kind and colour are known.
-  if (!sim_->held().empty()) {
-    for (const platform::SimObject& o : sim_->world().objects) {
-      if (o.id != sim_->held().front()) continue;
-      strategy::ObjectBelief held;
-      held.id = -1;
-      held.kind = o.type->name;
-      held.colour = o.colour;
-      held_ = held;
-    }
+  if (const std::optional<IntakeItem> preload = io_->Preload()) {
+    strategy::ObjectBelief held;
+    held.id = -1;
+    held.kind = preload->kind;
+    held.colour = preload->colour;
+    held_ = held;
   }
-  odometry_ = sim_->drive().odometry_pose();
-  gyro_heading_ = gyro_.Read(start_pose.theta_rad, 0.0);
-  odometry_scale_ = CalibrateOdometryScale(robot_);
+  odometry_ = io_->OdometryPose();
+  if (setup_.gyro) {
+    const std::optional<double> heading = io_->GyroHeadingRad();
+    if (!heading) {
+      throw std::invalid_argument(
+          "this robot has no yaw gyro (" + io_->Describe() +
+          "): run without gyro-aided odometry (MatchSetup::gyro = false, --no-gyro)");
+    }
+    gyro_heading_ = *heading;
+  }
+  odometry_scale_ = io_->OdometryScale();
   drive_options_ = platform::DriveControllerOptionsFor(robot_.drive);
   drive_options_.hard_deadline_s = deadline_s_;
   drive_options_.timeout_margin_s = 2.0;  // a blocked step gives up quickly in a match
@@ -196,7 +210,7 @@ MatchWorld::MatchWorld(const field::SeasonConfig& season, const field::RobotConf
 
 strategy::Belief MatchWorld::Belief() const {
   strategy::Belief b;
-  b.now_s = clock_.NowS();
+  b.now_s = now_s();
   b.deadline_s = deadline_s_;
   b.pose = ekf_.pose();
   b.pose_covariance = ekf_.pose_covariance();
@@ -209,65 +223,70 @@ strategy::Belief MatchWorld::Belief() const {
   return b;
 }
 
-std::vector<Eigen::Vector2d> MatchWorld::landmark_truth() const {
-  std::vector<Eigen::Vector2d> out;
-  for (const Eigen::Vector3d& c : renderer_->landmark_centres()) out.push_back(c.head<2>());
-  return out;
-}
-
 double MatchWorld::ObjectRadius(const std::string& kind) const {
   const field::ObjectType* type = field_.FindObjectType(kind);
   return type ? type->size_m / 2.0 : 0.1;
 }
 
 void MatchWorld::Advance(double dt_s) {
-  sim_->Step(dt_s);
-  const platform::SimDriveBase& d = sim_->drive();
-  const bool driven =
-      d.left_pwm() != robot_.drive.pwm.stop || d.right_pwm() != robot_.drive.pwm.stop;
-  // The clock still shows the start of this step.
-  if (driven) {
-    last_motion_s_ = clock_.NowS() + dt_s;
-    if (clock_.NowS() >= deadline_s_) overrun_s_ += dt_s;
+  const double before_s = now_s();
+  io_->Advance(dt_s);
+  if (io_->MotorsDriven()) {
+    last_motion_s_ = now_s();
+    if (before_s >= deadline_s_) overrun_s_ += now_s() - before_s;
   }
 }
 
 void MatchWorld::RecordSample() {
-  const Pose2D& t = sim_->robot_pose();
-  samples_.push_back({clock_.NowS(), Eigen::Vector3d(t.x_m, t.y_m, t.theta_rad), ekf_.pose(),
-                      ekf_.pose_covariance()});
+  PoseSample sample{now_s(), Eigen::Vector3d::Zero(), ekf_.pose(), ekf_.pose_covariance(), false};
+  if (const std::optional<Pose2D> t = io_->TruePose()) {
+    sample.truth_known = true;
+    sample.truth = Eigen::Vector3d(t->x_m, t->y_m, t->theta_rad);
+  }
+  samples_.push_back(sample);
 }
 
 void MatchWorld::MaybeSnapshot(bool force) {
   if (setup_.snapshot_period_s <= 0.0) return;
-  if (!force && clock_.NowS() < next_snapshot_s_) return;
-  next_snapshot_s_ = clock_.NowS() + setup_.snapshot_period_s;
+  if (!force && now_s() < next_snapshot_s_) return;
+  next_snapshot_s_ = now_s() + setup_.snapshot_period_s;
   Snapshot s;
-  s.t_s = clock_.NowS();
-  s.truth = sim_->robot_pose();
+  s.t_s = now_s();
+  const std::optional<Pose2D> truth = io_->TruePose();
+  s.truth_known = truth.has_value();
+  if (truth) s.truth = *truth;
   // Between filter updates the estimate is the last one moved by the encoders since.
-  mapping::OdometryStep u = Increment(odometry_, sim_->drive().odometry_pose());
+  mapping::OdometryStep u = Increment(odometry_, io_->OdometryPose());
   u.dx_m *= odometry_scale_;
   u.dy_m *= odometry_scale_;
   s.estimate = mapping::EkfSlam::Move(ekf_.pose(), u, nullptr, nullptr);
   s.covariance = ekf_.pose_covariance();
-  for (const platform::SimObject& o : sim_->world().objects) {
-    if (o.held) continue;
-    s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.type->size_m / 2.0});
+  if (const platform::SimField* sim = io_->sim()) {
+    for (const platform::SimObject& o : sim->world().objects) {
+      if (o.held) continue;
+      s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.type->size_m / 2.0});
+    }
   }
   s.tracked = Belief().objects;
   s.action = action_label_;
-  s.points = Points();
+  s.points = Points().value_or(0);
   snapshots_.push_back(std::move(s));
 }
 
 bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
+  platform::DriveBodyLink body;
+  body.base = &io_->drive();
+  body.metres_per_tick = kPi * robot_.drive.wheel_diameter_m / robot_.drive.encoder_ticks_per_rev;
+  body.track_width_m = robot_.drive.track_width_m;
+  body.odometry_start = io_->OdometryPose();
+  body.clock = &io_->clock();
+  body.advance = [this](double dt) {
+    Advance(dt);
+    MaybeSnapshot();
+  };
   const std::vector<platform::DriveStepResult> results =
-      platform::RunDriveScript(steps, drive_options_, &sim_->drive(), &clock_, [this](double dt) {
-        Advance(dt);
-        MaybeSnapshot();
-      });
-  const Pose2D now = sim_->drive().odometry_pose();
+      platform::RunDriveScript(steps, drive_options_, body);
+  const Pose2D now = io_->OdometryPose();
   mapping::OdometryStep u = Increment(odometry_, now);
   u.dx_m *= odometry_scale_;
   u.dy_m *= odometry_scale_;
@@ -275,7 +294,7 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
     // Gyro-aided odometry: the turn comes from the gyro, which sees the body turn; the
     // encoders' turn is wrong whenever a wheel slips (and a turn blocked by a pinned object
     // spins the wheels without turning the robot at all).
-    const double heading = gyro_.Read(sim_->robot_pose().theta_rad, clock_.NowS());
+    const double heading = io_->GyroHeadingRad().value_or(gyro_heading_);
     u.dtheta_rad = platform::WrapAngleRad(heading - gyro_heading_);
     gyro_heading_ = heading;
   }
@@ -302,9 +321,20 @@ int MatchWorld::Observe(int max_frames) {
   int taken = 0;
   bool last_tracked = false;
   bool relocalised = false;
-  const Pose2D truth = sim_->robot_pose();
-  for (int frame = 1; clock_.NowS() < deadline_s_; ++frame) {
-    rgbd = renderer_->Render(sim_->world(), truth, clock_.NowS(), nullptr);
+  int missed_frames = 0;
+  const double dt = 1.0 / robot_.camera.frame_rate_hz;
+  for (int frame = 1; now_s() < deadline_s_; ++frame) {
+    std::optional<platform::RgbdFrame> captured = io_->Capture();
+    if (!captured) {
+      // No frame from the camera (RobotIo::Capture waited for one): try again a frame period
+      // later, and give up the look after three misses in a row.
+      if (++missed_frames >= 3) break;
+      --frame;
+      Advance(dt);
+      continue;
+    }
+    missed_frames = 0;
+    rgbd = std::move(*captured);
     std::vector<mapping::RangeBearing> measurements;
     for (const vision::Detection& d :
          vision::Detect(rgbd.colour, rgbd.depth_mm, landmark_detector_, {})) {
@@ -378,9 +408,7 @@ int MatchWorld::Observe(int max_frames) {
     last_tracked = frame == 1;
     ++taken;
     ++frames_;
-    const double dt = 1.0 / robot_.camera.frame_rate_hz;
     Advance(dt);
-    clock_.Advance(dt);
     RecordSample();
     MaybeSnapshot();
     if (!selector.Continue(ekf_.pose(), ekf_.pose_covariance())) break;
@@ -402,7 +430,7 @@ void MatchWorld::TrackObjects(const platform::RgbdFrame& rgbd) {
   // Placed through the best pose estimate (and its covariance).
   const Eigen::Vector3d pose = ekf_.pose();
   const double half_fov = std::atan(robot_.camera.width_px / 2.0 / robot_.camera.fx) - 0.05;
-  tracker_.Update(pose, ekf_.pose_covariance(), seen, clock_.NowS(), [&](const Eigen::Vector2d& p) {
+  tracker_.Update(pose, ekf_.pose_covariance(), seen, now_s(), [&](const Eigen::Vector2d& p) {
     const Eigen::Vector2d z = mapping::EkfSlam::Observe(pose, p);
     return z.x() > 0.8 && z.x() < 3.5 && std::abs(z.y()) < half_fov;
   });
@@ -464,8 +492,8 @@ bool MatchWorld::PathClear(const std::vector<Eigen::Vector2d>& path) const {
 
 bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, int frames_per_stop,
                           double budget_s) {
-  const double give_up_s = budget_s > 0.0 ? clock_.NowS() + budget_s : deadline_s_;
-  const auto out_of_time = [&]() { return clock_.NowS() >= std::min(give_up_s, deadline_s_); };
+  const double give_up_s = budget_s > 0.0 ? now_s() + budget_s : deadline_s_;
+  const auto out_of_time = [&]() { return now_s() >= std::min(give_up_s, deadline_s_); };
   for (int attempt = 0; attempt < 3 && !out_of_time(); ++attempt) {
     Eigen::Vector3d pose = ekf_.pose();
     if (!planner_->IsClear(pose.head<2>())) {
@@ -605,19 +633,16 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};
   if (std::abs(forward) > 0.01) steps.push_back(Forward(forward / odometry_scale_));
   Drive(steps);
-  if (clock_.NowS() >= deadline_s_) return false;
-  const std::optional<int> picked = sim_->Pick();
+  if (now_s() >= deadline_s_) return false;
+  const std::optional<IntakeItem> picked = io_->Pick(target);
   Wait(context_.robot ? setup_.strategy_options.pick_s : 1.0);
   if (!picked) return false;
-  // The intake knows what it took (kind and colour from its own sensor).
-  for (const platform::SimObject& o : sim_->world().objects) {
-    if (o.id != *picked) continue;
-    strategy::ObjectBelief held;
-    held.id = action.object_id;
-    held.kind = o.type->name;
-    held.colour = o.colour;
-    held_ = held;
-  }
+  // The intake knows what it took (kind and colour from its own sensor, or taken on trust).
+  strategy::ObjectBelief held;
+  held.id = action.object_id;
+  held.kind = picked->kind;
+  held.colour = picked->colour;
+  held_ = held;
   if (action.object_id >= 0) picked_ids_.push_back(action.object_id);
   UpdateMaps();
   return true;
@@ -645,19 +670,19 @@ bool MatchWorld::Score(const strategy::Action& action) {
   std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};
   if (std::abs(forward) > 0.01) steps.push_back(Forward(forward / odometry_scale_));
   Drive(steps);
-  if (clock_.NowS() >= deadline_s_) return false;
-  const std::optional<platform::ReleaseResult> released = sim_->Release();
+  if (now_s() >= deadline_s_) return false;
+  const std::optional<ReleaseOutcome> released = io_->Release(action.goal_index);
   Wait(setup_.strategy_options.release_s);
   // Back off the goal: pressed against it, the robot could not turn (its corners sweep the
   // structure) and its wheels would spin in place.
-  if (clock_.NowS() < deadline_s_) Drive({Forward(-kBackOff_m / odometry_scale_)});
+  if (now_s() < deadline_s_) Drive({Forward(-kBackOff_m / odometry_scale_)});
   if (!released) return false;
   held_.reset();
   return released->goal_index && *released->goal_index == action.goal_index;
 }
 
 void MatchWorld::IdleToDeadline() {
-  if (clock_.NowS() < deadline_s_) Wait(deadline_s_ - clock_.NowS());
+  if (now_s() < deadline_s_) Wait(deadline_s_ - now_s());
   MaybeSnapshot(true);
 }
 

@@ -1,9 +1,10 @@
-// Everything one simulated match runs on, behind the operations the executive needs: the
-// simulated field and its camera, SLAM-O (EKF over pose and surveyed markers, the object
+// Everything one match runs on, behind the operations the executive needs: the robot (through
+// RobotIo: the simulated field and its camera in a dry run, the board and a camera on match
+// day), SLAM-O (EKF over pose and surveyed markers, the object
 // tracker, the OctoMap object map), the planner on that map and the travel times the strategy
 // asks for. Each operation advances the match clock and stops at the deadline; the robot is
-// only ever steered from SLAM-O's estimate, never from the simulator's truth (the truth is
-// recorded for the report).
+// only ever steered from SLAM-O's estimate, never from the simulator's truth (the truth, when
+// there is one, is recorded for the report).
 #pragma once
 
 #include <cstdint>
@@ -15,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "autonomy/robot_io.h"
 #include "field_configs/robot_config.h"
 #include "field_configs/season_config.h"
 #include "mapping/ekf_slam.h"
@@ -25,8 +27,6 @@
 #include "platform/clock.h"
 #include "platform/drive_script.h"
 #include "platform/sim_field.h"
-#include "platform/sim_gyro.h"
-#include "platform/sim_renderer.h"
 #include "strategy/strategy.h"
 #include "strategy/travel_field.h"
 #include "vision/detector.h"
@@ -60,6 +60,7 @@ struct MatchSetup {
 // A moment of the match for the replay and the map picture.
 struct Snapshot {
   double t_s = 0.0;
+  bool truth_known = true;  // false on hardware: truth and truth_objects are empty
   platform::Pose2D truth;
   Eigen::Vector3d estimate = Eigen::Vector3d::Zero();
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
@@ -80,16 +81,23 @@ struct PoseSample {
   Eigen::Vector3d truth = Eigen::Vector3d::Zero();
   Eigen::Vector3d estimate = Eigen::Vector3d::Zero();
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  bool truth_known = true;  // false on hardware (truth is then zero)
 };
 
 class MatchWorld {
  public:
+  // On the simulated field, its objects placed for `seed` (PlaceObjects).
   MatchWorld(const field::SeasonConfig& season, const field::RobotConfig& robot,
              const MatchSetup& setup, uint64_t seed, bool perceive);
+  // On `io` (the robot), the season's objects where its file puts them; `seed` seeds the
+  // planners. Calls io->Start().
+  MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& season,
+             const field::RobotConfig& robot, const MatchSetup& setup, uint64_t seed,
+             bool perceive);
 
-  double now_s() const { return clock_.NowS(); }
+  double now_s() const { return io_->clock().NowS(); }
   double deadline_s() const { return deadline_s_; }
-  double time_left_s() const { return deadline_s_ - clock_.NowS(); }
+  double time_left_s() const { return deadline_s_ - now_s(); }
 
   strategy::Belief Belief() const;
   const strategy::StrategyContext& Context() const { return context_; }
@@ -112,16 +120,21 @@ class MatchWorld {
   // Stands still until the deadline.
   void IdleToDeadline();
 
-  int Points() const { return sim_->Score(setup_.alliance); }
+  // The alliance's points now, when known (the simulator).
+  std::optional<int> Points() const { return io_->Points(); }
   const field::SeasonConfig& field() const { return field_; }
-  const platform::SimField& sim() const { return *sim_; }
+  // The simulated field; null on hardware.
+  const platform::SimField* sim() const { return io_->sim(); }
+  RobotIo& io() { return *io_; }
+  const RobotIo& io() const { return *io_; }
   const mapping::EkfSlam& ekf() const { return ekf_; }
   const mapping::ObjectTracker& tracker() const { return tracker_; }
   const mapping::ObjectMap& object_map() const { return object_map_; }
   const std::vector<PoseSample>& samples() const { return samples_; }
   const std::vector<Snapshot>& snapshots() const { return snapshots_; }
   const std::vector<std::vector<Eigen::Vector2d>>& paths() const { return paths_; }
-  std::vector<Eigen::Vector2d> landmark_truth() const;
+  // The surveyed marker centres (what SLAM-O is given, and on the simulated field the truth).
+  const std::vector<Eigen::Vector2d>& landmark_truth() const { return markers_; }
   double overrun_s() const { return overrun_s_; }
   int frames() const { return frames_; }
   int replans() const { return replans_; }
@@ -139,6 +152,7 @@ class MatchWorld {
   void MaybeSnapshot(bool force = false);
   void UpdateMaps();
   void TrackObjects(const platform::RgbdFrame& rgbd);
+  void Init(uint64_t seed);
   bool PathClear(const std::vector<Eigen::Vector2d>& path) const;
   double ObjectRadius(const std::string& kind) const;
 
@@ -147,9 +161,8 @@ class MatchWorld {
   MatchSetup setup_;
   bool perceive_;
   double deadline_s_;
-  platform::SimClock clock_;
-  std::unique_ptr<platform::SimField> sim_;
-  std::unique_ptr<platform::SimRenderer> renderer_;
+  std::unique_ptr<RobotIo> io_;
+  std::vector<Eigen::Vector2d> markers_;
   vision::DetectorSetup landmark_detector_;
   vision::DetectorSetup object_detector_;
   std::vector<int> marker_id_;
@@ -158,7 +171,6 @@ class MatchWorld {
   mapping::ObjectMap object_map_;    // every confirmed object: the map SLAM-O keeps
   mapping::ObjectMap obstacle_map_;  // what the planner avoids (pushable objects left out)
   std::unique_ptr<planning::Planner> planner_;
-  platform::SimGyro gyro_;
   double gyro_heading_ = 0.0;  // the gyro's reading at the last prediction
   strategy::TravelField travel_;
   strategy::StrategyContext context_;
@@ -179,6 +191,21 @@ class MatchWorld {
   int relocalisations_ = 0;
   int rejected_frames_ = 0;
 };
+
+// The surveyed perimeter markers' centres: where the renderer draws them (a plate's centre
+// sits just off its wall), which is where a team's tape measure puts them.
+std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field);
+// Each marker's id in the filter: its index when no other marker shares its colour, else -1
+// (associated by position).
+std::vector<int> MarkerIds(const field::SeasonConfig& field);
+// The markers into `ekf` as known landmarks; a colour shared by several is associated by
+// position (JCBB). Returns each marker's id in the filter (-1: associated by position).
+std::vector<int> AddSurveyedMarkers(const field::SeasonConfig& field, mapping::EkfSlam* ekf);
+
+// The pose of the alliance's start_index-th starting tile (throws std::invalid_argument when
+// there is none).
+platform::Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance,
+                           int start_index);
 
 // The season with its fixed-position floor objects moved uniformly up to jitter_m (clear of
 // walls and structures), so no two seeds share a layout; preloads (objects on a starting

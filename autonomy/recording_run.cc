@@ -8,11 +8,11 @@
 #include <optional>
 #include <stdexcept>
 
+#include "autonomy/match_world.h"
 #include "mapping/ekf_slam.h"
 #include "mapping/object_map.h"
 #include "mapping/object_tracker.h"
 #include "platform/recording.h"
-#include "platform/sim_renderer.h"
 #include "vision/detector.h"
 
 namespace slamo::autonomy {
@@ -68,6 +68,8 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
   MatchResult result;
   result.season = season.name;
   result.strategy = "recording";
+  result.robot_io = "recording " + dir;
+  result.truth_known = false;  // no points: nothing scores a recording
   result.frames = "every frame of " + dir;
   result.field = season;
 
@@ -78,18 +80,8 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
   mapping::EkfSlam ekf(Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad),
                        Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal(),
                        ekf_options);
-  const platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 0);
-  std::vector<int> marker_id(season.landmarks.size(), -1);
-  for (size_t i = 0; i < season.landmarks.size(); ++i) {
-    const auto same = std::count_if(
-        season.landmarks.begin(), season.landmarks.end(),
-        [&](const field::Landmark& l) { return l.colour == season.landmarks[i].colour; });
-    if (same == 1) marker_id[i] = static_cast<int>(i);
-    ekf.AddKnownLandmark(renderer.landmark_centres()[i].head<2>(),
-                         Eigen::Matrix2d::Identity() * 1e-6, marker_id[i],
-                         season.landmarks[i].colour);
-    result.landmark_truth.push_back(renderer.landmark_centres()[i].head<2>());
-  }
+  const std::vector<int> marker_id = AddSurveyedMarkers(season, &ekf);
+  result.landmark_truth = SurveyedMarkers(season);
   const vision::DetectorSetup landmark_detector =
       vision::LandmarkDetectorSetup(season, &robot.camera);
   const vision::DetectorSetup object_detector = vision::ObjectDetectorSetup(season, &robot.camera);
@@ -201,9 +193,10 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
     const Pose2D t = has_truth ? TruthAt(truth, rgbd->t_s)
                                : Pose2D{ekf.pose().x(), ekf.pose().y(), ekf.pose().z()};
     const Eigen::Vector3d truth_v(t.x_m, t.y_m, t.theta_rad);
-    result.samples.push_back({rgbd->t_s, truth_v, ekf.pose(), ekf.pose_covariance()});
+    result.samples.push_back({rgbd->t_s, truth_v, ekf.pose(), ekf.pose_covariance(), has_truth});
     Snapshot s;
     s.t_s = rgbd->t_s;
+    s.truth_known = has_truth;
     s.truth = t;
     s.estimate = ekf.pose();
     s.covariance = ekf.pose_covariance();

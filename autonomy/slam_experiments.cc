@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "autonomy/match_world.h"
 #include "mapping/object_map.h"
 #include "platform/drive_script.h"
 #include "platform/sim_field.h"
@@ -81,13 +82,7 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
                        Eigen::Vector3d(1e-6, 1e-6, 1e-6).asDiagonal(), setup.ekf);
   // A marker is identified by its colour only when no other marker shares it; otherwise the
   // filter associates it by position.
-  std::vector<int> marker_id(field.landmarks.size(), -1);
-  for (size_t i = 0; i < field.landmarks.size(); ++i) {
-    const auto same = std::count_if(
-        field.landmarks.begin(), field.landmarks.end(),
-        [&](const field::Landmark& l) { return l.colour == field.landmarks[i].colour; });
-    if (same == 1) marker_id[i] = static_cast<int>(i);
-  }
+  const std::vector<int> marker_id = MarkerIds(field);
   if (setup.known_landmarks) {
     for (size_t i = 0; i < field.landmarks.size(); ++i) {
       ekf.AddKnownLandmark(

@@ -326,6 +326,20 @@ struct SimRenderer::Buffers {
   }
 };
 
+Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& l) {
+  if (l.shape != field::LandmarkShape::kDisc && l.shape != field::LandmarkShape::kSquare)
+    return Vector3d(l.position_m.x, l.position_m.y, l.height_m);
+  // A plate: on the inner face of the nearest wall.
+  const double inset = season.HalfSize() - 0.005;
+  double x = l.position_m.x, y = l.position_m.y;
+  if (std::abs(l.position_m.x) >= std::abs(l.position_m.y)) {
+    x = std::clamp(x, -inset, inset);
+  } else {
+    y = std::clamp(y, -inset, inset);
+  }
+  return Vector3d(x, y, l.height_m);
+}
+
 SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraConfig& camera,
                          RenderOptions options, uint64_t seed)
     : season_(season),
@@ -381,7 +395,6 @@ void SimRenderer::BuildStaticPrimitives() {
   }
   // Landmarks: discs and squares are plates on the inner face of the nearest wall, facing the
   // field; cylinders and spheres stand where they are.
-  const double half = season_.HalfSize();
   for (size_t i = 0; i < season_.landmarks.size(); ++i) {
     const field::Landmark& l = season_.landmarks[i];
     Primitive p;
@@ -396,24 +409,17 @@ void SimRenderer::BuildStaticPrimitives() {
       p.radius = r;
       p.half_x = r;
       const bool on_x_wall = std::abs(l.position_m.x) >= std::abs(l.position_m.y);
-      double x = l.position_m.x, y = l.position_m.y;
-      const double inset = half - 0.005;
-      if (on_x_wall) {
-        x = std::clamp(x, -inset, inset);
-        p.plate_normal = Vector3d(x > 0 ? -1.0 : 1.0, 0.0, 0.0);
-      } else {
-        y = std::clamp(y, -inset, inset);
-        p.plate_normal = Vector3d(0.0, y > 0 ? -1.0 : 1.0, 0.0);
-      }
-      p.center = Vector3d(x, y, l.height_m);
+      p.center = LandmarkCentre(season_, l);
+      p.plate_normal = on_x_wall ? Vector3d(p.center.x() > 0 ? -1.0 : 1.0, 0.0, 0.0)
+                                 : Vector3d(0.0, p.center.y() > 0 ? -1.0 : 1.0, 0.0);
     } else if (l.shape == field::LandmarkShape::kCylinder) {
       p.kind = PrimitiveKind::kCylinder;
       p.radius = r;
-      p.center = Vector3d(l.position_m.x, l.position_m.y, l.height_m);
+      p.center = LandmarkCentre(season_, l);
     } else {
       p.kind = PrimitiveKind::kSphere;
       p.radius = r;
-      p.center = Vector3d(l.position_m.x, l.position_m.y, l.height_m);
+      p.center = LandmarkCentre(season_, l);
     }
     SetAabb(&p);
     landmark_centres_.push_back(p.center);

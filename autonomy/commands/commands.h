@@ -4,9 +4,21 @@
 
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <functional>
+#include <iostream>
+#include <string>
 
 namespace slamo::autonomy {
+
+// Creates an output folder (and its parents); false, with the reason on stderr, when it
+// cannot (the command then exits 1).
+inline bool CreateOutputDir(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) std::cerr << "error: " << dir << ": " << ec.message() << "\n";
+  return !ec;
+}
 
 // A registered subcommand runs this after parsing; it returns the process exit status.
 using CommandAction = std::function<int()>;

@@ -43,12 +43,7 @@ struct DryRunArgs {
 int DryRunRecording(const DryRunArgs& args) {
   const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
   const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
-  std::error_code ec;
-  std::filesystem::create_directories(args.out, ec);
-  if (ec) {
-    std::cerr << "error: " << args.out << ": " << ec.message() << "\n";
-    return 1;
-  }
+  if (!CreateOutputDir(args.out)) return 1;
   std::cout << "dry run: " << season.name << " (" << season.season << ") on the recording "
             << args.recording << "\n";
   MatchResult result;
@@ -61,28 +56,17 @@ int DryRunRecording(const DryRunArgs& args) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
   }
-  const bool has_truth = !std::isnan(result.pose_ate_m);
   PrintSummary(result, std::cout);
-  if (!has_truth)
+  if (std::isnan(result.pose_ate_m))
     std::cout << "  (the recording has no ground truth: pose ATE is not available and the "
                  "truth columns repeat the estimate)\n";
-  const std::string dir = args.out + "/";
   try {
-    {
-      std::ofstream report(dir + "report.json");
-      report << ReportJson(result).dump(2) << "\n";
-      if (!report) throw std::runtime_error("cannot write " + dir + "report.json");
-    }
-    WriteTum(result, dir + "trajectory.tum");
-    if (has_truth) WriteTruthTum(result, dir + "groundtruth.tum");
-    if (!cv::imwrite(dir + "map.png", DrawMatchMap(result)))
-      throw std::runtime_error("cannot write " + dir + "map.png");
+    const std::vector<std::string> written = WriteMatchFiles(result, args.out, false);
+    std::cout << "wrote " << args.out << "/{" << Join(written) << ", objects.bt}\n";
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;
   }
-  std::cout << "wrote " << dir << "{report.json, map.png, trajectory.tum, "
-            << (has_truth ? "groundtruth.tum, " : "") << "objects.bt}\n";
   return 0;
 }
 
@@ -101,12 +85,7 @@ int DryRun(const DryRunArgs& args) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
   }
-  std::error_code ec;
-  std::filesystem::create_directories(args.out, ec);
-  if (ec) {
-    std::cerr << "error: " << args.out << ": " << ec.message() << "\n";
-    return 1;
-  }
+  if (!CreateOutputDir(args.out)) return 1;
   std::cout << "dry run: " << season.name << " (" << season.season << "), seed " << args.seed
             << ", strategy " << args.strategy << ", " << season.rules.autonomous_s
             << " s autonomous\n";
@@ -118,20 +97,8 @@ int DryRun(const DryRunArgs& args) {
   PrintSummary(result, std::cout);
 
   const std::string dir = args.out + "/";
-  {
-    std::ofstream report(dir + "report.json");
-    report << ReportJson(result).dump(2) << "\n";
-    if (!report) {
-      std::cerr << "error: cannot write " << dir << "report.json\n";
-      return 1;
-    }
-  }
   try {
-    WriteTum(result, dir + "trajectory.tum");
-    WriteTruthTum(result, dir + "groundtruth.tum");
-    if (!cv::imwrite(dir + "map.png", DrawMatchMap(result)))
-      throw std::runtime_error("cannot write " + dir + "map.png");
-    if (args.video) WriteReplay(result, dir + "replay.avi");
+    const std::vector<std::string> written = WriteMatchFiles(result, args.out, args.video);
     if (args.frames_png) {
       std::filesystem::create_directories(dir + "replay");
       for (size_t k = 0; k < result.snapshots.size(); ++k) {
@@ -140,13 +107,11 @@ int DryRun(const DryRunArgs& args) {
         cv::imwrite(dir + name, DrawSnapshot(result, k));
       }
     }
+    std::cout << "wrote " << args.out << "/{" << Join(written) << ", objects.bt}\n";
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;
   }
-  std::cout << "wrote " << dir
-            << "{report.json, map.png, trajectory.tum, groundtruth.tum, objects.bt"
-            << (args.video ? ", replay.avi" : "") << "}\n";
   return 0;
 }
 
