@@ -523,6 +523,7 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
     request.goal_heading_deg = target.z() * 180.0 / kPi;
     request.planner = setup_.planner;
     request.time_budget_s = setup_.plan_budget_s;
+    request.max_iterations = setup_.plan_iterations;
     planning::PlanResult plan = planner_->Plan(request);
     if (plan.status != planning::PlanStatus::kSolved) {
       return false;

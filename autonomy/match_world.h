@@ -42,6 +42,9 @@ struct MatchSetup {
   double placement_jitter_m = 0.15;  // fixed-position objects moved up to this per seed
   std::string planner = "rrtconnect";
   double plan_budget_s = 0.05;
+  // Planner iterations per attempt instead of a time budget, so that a match depends only on
+  // its seed, not on how busy the machine is (PlanRequest::max_iterations; 0: the budget).
+  int plan_iterations = 10000;
   double snapshot_period_s = 0.25;  // match time between replay snapshots (0: none)
   double drive_speed_mps = 0.0;     // 0: the robot's drive.match_speed_mps
   // How the executive drives with SLAM-O (perceiving strategies): a quick look of

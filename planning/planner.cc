@@ -441,14 +441,26 @@ PlanResult Planner::Plan(const PlanRequest& request) const {
     return request.time_budget_s -
            std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   };
+  const bool deterministic = request.max_iterations > 0;
+  const double guard_s = std::max(1.0, 20.0 * request.time_budget_s);
+  // Stops after max_iterations evaluations (the planners evaluate it once per iteration), or at
+  // the wall-clock guard.
+  const auto iterations = [&](int limit) {
+    auto count = std::make_shared<int>(0);
+    return ob::plannerOrTerminationCondition(
+        ob::PlannerTerminationCondition([count, limit] { return ++*count > limit; }),
+        ob::timedPlannerTerminationCondition(guard_s));
+  };
   double best_m = std::numeric_limits<double>::infinity();
   for (int attempt = 0; attempt < attempts; ++attempt) {
     if (attempt > 0) {
-      if (left_s() <= 0.0) break;
+      if (!deterministic && left_s() <= 0.0) break;
+      if (deterministic && result.status != PlanStatus::kSolved) break;
       setup.clear();
     }
     const ob::PlannerStatus status =
-        setup.solve(ob::timedPlannerTerminationCondition(std::max(left_s(), 1e-4)));
+        deterministic ? setup.solve(iterations(request.max_iterations))
+                      : setup.solve(ob::timedPlannerTerminationCondition(std::max(left_s(), 1e-4)));
     PlanStatus attempt_status = PlanStatus::kTimedOut;
     if (status == ob::PlannerStatus::EXACT_SOLUTION) {
       attempt_status = PlanStatus::kSolved;
@@ -466,7 +478,13 @@ PlanResult Planner::Plan(const PlanRequest& request) const {
     if (attempt_status == PlanStatus::kApproximate && result.status == PlanStatus::kSolved) {
       continue;  // an earlier attempt found a path to the goal
     }
-    if (rrtconnect) setup.simplifySolution(std::max(0.005, left_s()));
+    if (rrtconnect) {
+      if (deterministic) {
+        setup.simplifySolution(ob::timedPlannerTerminationCondition(guard_s));
+      } else {
+        setup.simplifySolution(std::max(0.005, left_s()));
+      }
+    }
     std::vector<Eigen::Vector2d> points;
     const og::PathGeometric& path = setup.getSolutionPath();
     for (size_t i = 0; i < path.getStateCount(); ++i) {

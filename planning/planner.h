@@ -73,6 +73,12 @@ struct PlanRequest {
   double goal_heading_deg = 0.0;
   std::string planner = "rrtconnect";  // one of PlannerNames()
   double time_budget_s = 0.05;         // planning and simplification together, seconds
+  // > 0: a plan that depends only on the seed, not on how busy the machine is. Each attempt
+  // stops after this many planner iterations instead of at the time budget, RRTConnect makes
+  // all its attempts (none after one that fails) and the simplifier runs until it stops
+  // improving. A wall-clock guard of 20x time_budget_s (at least 1 s) still ends a runaway.
+  // The match uses this; the benchmark measures the time-budgeted mode.
+  int max_iterations = 0;
 };
 
 enum class PlanStatus { kSolved, kApproximate, kTimedOut, kInvalidStart, kInvalidGoal };

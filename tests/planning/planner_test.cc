@@ -1,8 +1,14 @@
 #include "planning/planner.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -84,6 +90,53 @@ TEST_F(PlannerTest, EveryPlannerSolvesAnOpenQuery) {
     EXPECT_EQ(result.status, PlanStatus::kSolved) << name << ": " << PlanStatusName(result.status);
     ExpectPathClear(planner, result.path);
   }
+}
+
+// With max_iterations the plan depends only on the seed: each plan runs in a fresh child
+// process seeded alike (OMPL's seed is process-wide), once with a generous time budget and
+// once with a budget far too small to plan in, while another thread keeps a core busy. The
+// paths are the same to the bit.
+TEST_F(PlannerTest, IterationBoundedPlansDependOnlyOnTheSeed) {
+  const Planner planner = MakePlanner(*season_);
+  const auto plan_in_child = [&](double budget_s, bool busy) {
+    int fds[2];
+    EXPECT_EQ(::pipe(fds), 0);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      ::close(fds[0]);
+      std::atomic<bool> stop{false};
+      std::thread hog([&] {
+        volatile double x = 0.0;
+        while (busy && !stop) x = x + 1.0;
+      });
+      SeedPlanners(7);
+      PlanRequest request = Request(-1.524, 0.3048, 0.3, -1.2);
+      request.time_budget_s = budget_s;
+      request.max_iterations = 10000;
+      const PlanResult r = planner.Plan(request);
+      stop = true;
+      hog.join();
+      const int status = static_cast<int>(r.status);
+      ssize_t ok = ::write(fds[1], &status, sizeof(status));
+      for (const Eigen::Vector2d& p : r.path) ok = ::write(fds[1], p.data(), 2 * sizeof(double));
+      ::_exit(ok >= 0 ? 0 : 1);
+    }
+    ::close(fds[1]);
+    std::vector<double> out;
+    int status = -1;
+    EXPECT_EQ(::read(fds[0], &status, sizeof(status)), static_cast<ssize_t>(sizeof(status)));
+    double v = 0.0;
+    while (::read(fds[0], &v, sizeof(v)) == static_cast<ssize_t>(sizeof(v))) out.push_back(v);
+    ::close(fds[0]);
+    int exit_status = 0;
+    ::waitpid(pid, &exit_status, 0);
+    EXPECT_EQ(status, static_cast<int>(PlanStatus::kSolved));
+    return out;
+  };
+  const std::vector<double> calm = plan_in_child(1.0, false);
+  const std::vector<double> rushed = plan_in_child(1e-9, true);
+  ASSERT_GE(calm.size(), 4u);
+  EXPECT_EQ(calm, rushed);
 }
 
 TEST_F(PlannerTest, StartOrGoalInsideTheRedGoalIsInvalid) {
