@@ -108,6 +108,8 @@ class HardwareIo : public RobotIo {
   // Services the link until it is up; false after connect_timeout_s (the reason is the
   // link's state). Call before the match.
   bool Connect();
+  // Records from now on (HardwareIoOptions::recorder).
+  void set_recorder(platform::RecordingWriter* recorder) { options_.recorder = recorder; }
 
   void Start(const field::SeasonConfig& field, const field::RobotConfig& robot,
              const platform::Pose2D& start) override;

@@ -274,12 +274,7 @@ void MatchWorld::MaybeSnapshot(bool force) {
 }
 
 bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
-  platform::DriveBodyLink body;
-  body.base = &io_->drive();
-  body.metres_per_tick = kPi * robot_.drive.wheel_diameter_m / robot_.drive.encoder_ticks_per_rev;
-  body.track_width_m = robot_.drive.track_width_m;
-  body.odometry_start = io_->OdometryPose();
-  body.clock = &io_->clock();
+  platform::DriveBodyLink body = DriveLinkFor(*io_, robot_);
   body.advance = [this](double dt) {
     Advance(dt);
     MaybeSnapshot();

@@ -16,6 +16,7 @@
 #include "field_configs/season_config.h"
 #include "platform/clock.h"
 #include "platform/drive_base.h"
+#include "platform/drive_script.h"
 #include "platform/rgbd.h"
 #include "platform/sim_field.h"
 #include "strategy/strategy.h"
@@ -75,6 +76,10 @@ class RobotIo {
   // Counters for the report (link losses, frames missed, ...); none on the simulator.
   virtual std::map<std::string, double> Status() const { return {}; }
 };
+
+// The drive controller's link to io's drive base (RunDriveScript): the robot's wheel geometry,
+// the match clock, io.Advance as the passing of time, io's truth when it has one.
+platform::DriveBodyLink DriveLinkFor(RobotIo& io, const field::RobotConfig& robot);
 
 // The simulated field of a dry run: SimField (drive base with slip, objects, opponents,
 // intake, scoring), its camera renderer and a yaw gyro, all seeded by `seed`; time on a

@@ -18,29 +18,20 @@
 // motors 50 ms after the host goes quiet; the executive stops them at the deadline.
 // Exit status: 0 after a run, 1 when the board did not answer or a file cannot be written,
 // 2 on bad input, 3 when the camera cannot be opened.
-#include <unistd.h>
-
-#include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "autonomy/commands/commands.h"
 #include "autonomy/executive.h"
-#include "autonomy/hardware_io.h"
 #include "autonomy/match_report.h"
+#include "autonomy/robot_rig.h"
 #include "field_configs/loader.h"
 #include "mapping/frame_selection.h"
-#include "platform/fake_board.h"
 #include "platform/openni2_camera.h"
 #include "platform/recording.h"
-#include "platform/serial_drive_base.h"
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
 #include "strategy/strategy.h"
 
 namespace slamo::autonomy {
@@ -93,156 +84,55 @@ int Match(const MatchArgs& args) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
   }
-  if (args.port.empty() == !args.fake_board) {
-    std::cerr << "error: give the board's serial device (--port DEV) or --fake-board\n";
-    return 2;
-  }
-  std::string camera = args.camera;
-  if (camera.empty()) camera = !args.recording.empty() ? "recording" : "openni2";
-  if (camera == "recording" && args.recording.empty()) {
-    std::cerr << "error: --camera recording needs --recording PATH\n";
-    return 2;
-  }
-  if (camera == "sim" && !args.fake_board) {
-    std::cerr << "error: --camera sim renders the simulated field from the fake board's motors: "
-                 "it needs --fake-board\n";
-    return 2;
-  }
-  if (camera != "recording" && camera != "openni2" && camera != "sim") {
-    std::cerr << "error: --camera: expected openni2, recording or sim, got \"" << camera << "\"\n";
-    return 2;
-  }
-  if (!CreateOutputDir(args.out)) return 1;
-
-  // The clock: the machine's on the robot; simulated with the fake board unless --real-time.
-  platform::SteadyClock steady;
-  platform::SimClock simulated;
-  const bool sim_time = args.fake_board && !args.real_time;
-  const platform::Clock& base_clock =
-      sim_time ? static_cast<const platform::Clock&>(simulated) : steady;
-
-  // The board: on its serial device, or the fake one on a pseudo-terminal in this process.
-  std::unique_ptr<platform::PtyFakeBoard> fake;
-  std::string device = args.port;
-  if (args.fake_board) {
-    platform::FakeBoardOptions options;
-    options.seed = args.seed;
-    options.faults.drop_probability = args.drop;
-    options.faults.garbage_probability = args.garbage;
-    options.faults.duplicate_probability = args.duplicate;
-    fake = std::make_unique<platform::PtyFakeBoard>(robot.drive, options);
-    device = fake->device_path();
-  }
-  platform::SerialDriveOptions link_options;
-  link_options.pid = robot.drive.pid;
-  platform::SerialDriveBase board(platform::MakeMrptSerialTransport(device, args.baud), base_clock,
-                                  link_options);
-  bool unplugged = false, replugged = false;
-  const auto pace = [&](double dt_s) {
-    if (fake) {
-      fake->Pump(dt_s);
-      if (args.unplug_at_s >= 0 && !unplugged && base_clock.NowS() >= args.unplug_at_s) {
-        fake->Unplug();
-        unplugged = true;
-        std::cout << "  [board clock " << base_clock.NowS() << " s] fake board unplugged\n";
-      }
-      if (unplugged && !replugged && args.replug_at_s >= 0 &&
-          base_clock.NowS() >= args.replug_at_s) {
-        fake->Replug();
-        replugged = true;
-        std::cout << "  [board clock " << base_clock.NowS() << " s] fake board plugged in again\n";
-      }
-    }
-    if (sim_time) {
-      // The kernel passes the pty's bytes on in its own time: give it a moment per step.
-      ::usleep(150);
-      simulated.Advance(dt_s);
-    } else {
-      std::this_thread::sleep_for(std::chrono::duration<double>(dt_s));
-    }
-  };
-
-  // The camera.
-  const platform::Pose2D start = StartPose(season, setup.alliance, setup.start_index);
-  // The match clock (0 at the start) for a recorded stream is the base clock from Start();
-  // the stream camera reads the HardwareIo's match clock, so it is created after it.
-  HardwareIoOptions io_options;
-  io_options.alliance = setup.alliance;
-  io_options.odometry_scale = args.odometry_scale;
-  io_options.board_name = args.fake_board ? "fake board on " + device : device;
-  std::unique_ptr<platform::RgbdCamera> camera_device;
-  std::unique_ptr<FakeBoardCamera> sim_camera;
-  std::unique_ptr<platform::RecordingReader> reader;
+  RigOptions rig_options;
+  rig_options.port = args.port;
+  rig_options.baud = args.baud;
+  rig_options.fake_board = args.fake_board;
+  rig_options.real_time = args.real_time;
+  rig_options.camera = args.camera;
+  rig_options.recording = args.recording;
+  rig_options.loop = args.loop;
+  rig_options.seed = args.seed;
+  rig_options.faults.drop_probability = args.drop;
+  rig_options.faults.garbage_probability = args.garbage;
+  rig_options.faults.duplicate_probability = args.duplicate;
+  rig_options.unplug_at_s = args.unplug_at_s;
+  rig_options.replug_at_s = args.replug_at_s;
+  rig_options.io.alliance = setup.alliance;
+  rig_options.io.odometry_scale = args.odometry_scale;
+  std::unique_ptr<Rig> rig;
+  std::unique_ptr<platform::RecordingWriter> recorder;
   try {
-    if (camera == "recording") {
-      reader = platform::OpenRecording(args.recording);
-      io_options.camera_name = "recording " + args.recording;
-    } else if (camera == "sim") {
-      sim_camera = std::make_unique<FakeBoardCamera>(season, robot, fake->board(), start,
-                                                     base_clock, args.seed);
-      io_options.camera_name = "simulated field seen from the fake board's motors";
-      FakeBoardCamera* c = sim_camera.get();
-      io_options.truth = [c]() { return std::optional<platform::Pose2D>(c->Truth()); };
-    } else {
-      camera_device = std::make_unique<platform::OpenNI2Camera>(robot.camera);
-      io_options.camera_name = "openni2 " + robot.camera.model;
+    rig = std::make_unique<Rig>(rig_options, season, robot,
+                                StartPose(season, setup.alliance, setup.start_index));
+    if (!CreateOutputDir(args.out)) return 1;
+    if (!args.record.empty()) {
+      platform::RecordingInfo info = platform::RecordingInfoFor(robot);
+      info.source = args.fake_board ? "fake board" : "robot";
+      info.description = "slamo match on " + season.season + ": board " + rig->board_name() +
+                         ", camera " + rig->camera_name();
+      recorder = platform::OpenTumWriter(args.record, info);
+      rig->SetRecorder(recorder.get());
     }
+    std::cout << "match: " << season.name << " (" << season.season << "), "
+              << season.rules.autonomous_s << " s autonomous, robot " << robot.name << ", strategy "
+              << args.strategy << "\n  board  " << rig->board_name() << "\n  camera "
+              << rig->camera_name() << "\n";
+    rig->Connect();
+  } catch (const RigError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return e.exit_status;
   } catch (const platform::RecordingError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
-  } catch (const platform::CameraError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 3;
   }
-
-  std::unique_ptr<platform::RecordingWriter> recorder;
-  if (!args.record.empty()) {
-    try {
-      platform::RecordingInfo info = platform::RecordingInfoFor(robot);
-      info.source = args.fake_board ? "fake board" : "robot";
-      info.description = "slamo match on " + season.season + ": board " + io_options.board_name +
-                         ", camera " + io_options.camera_name;
-      recorder = platform::OpenTumWriter(args.record, info);
-    } catch (const platform::RecordingError& e) {
-      std::cerr << "error: " << e.what() << "\n";
-      return 2;
-    }
-    io_options.recorder = recorder.get();
-  }
-
-  // A recorded stream plays against the match clock, which only exists inside HardwareIo:
-  // a small forwarding camera resolves it on first use.
-  struct Forward : platform::RgbdCamera {
-    std::function<std::optional<platform::RgbdFrame>()> grab;
-    std::optional<platform::RgbdFrame> Grab() override { return grab(); }
-  } forward;
-  auto io = std::make_unique<HardwareIo>(&board, &forward, base_clock, pace, io_options);
-  std::unique_ptr<RecordedStreamCamera> stream;
-  if (reader)
-    stream = std::make_unique<RecordedStreamCamera>(std::move(reader), io->clock(), args.loop);
-  forward.grab = [&]() -> std::optional<platform::RgbdFrame> {
-    if (stream) return stream->Grab();
-    if (sim_camera) return sim_camera->Grab();
-    return camera_device->Grab();
-  };
-
-  std::cout << "match: " << season.name << " (" << season.season << "), "
-            << season.rules.autonomous_s << " s autonomous, robot " << robot.name << ", strategy "
-            << args.strategy << "\n  board  " << io_options.board_name << "\n  camera "
-            << io_options.camera_name << "\n";
-  if (!io->Connect()) {
-    std::cerr << "error: the board on " << device << " did not answer within "
-              << io_options.connect_timeout_s << " s (link "
-              << platform::LinkStateName(board.link_state())
-              << "); check the cable and `slamo board ping --port " << device << "`\n";
-    return 1;
-  }
-  std::cout << "  link up after " << base_clock.NowS() << " s; the match starts now\n";
+  std::cout << "  link up after " << rig->base_clock().NowS() << " s; the match starts now\n";
+  platform::SerialDriveBase& board = rig->board();
 
   MatchResult result;
   try {
     result = RunMatchOn(
-        std::move(io), strategy::MakeStrategy(args.strategy, setup.strategy_options), season, robot,
+        rig->TakeIo(), strategy::MakeStrategy(args.strategy, setup.strategy_options), season, robot,
         setup, args.seed, args.out, [&](const TimelineEntry& e) {
           if (!args.quiet)
             std::cout << "  [" << e.t_s << " s] " << e.action << " " << e.detail << std::endl;
@@ -266,7 +156,7 @@ int Match(const MatchArgs& args) {
     }
   }
   PrintSummary(result, std::cout);
-  if (fake) {
+  if (platform::PtyFakeBoard* fake = rig->fake()) {
     const platform::FakeBoard& b = fake->board();
     std::cout << "  fake board      motors stopped at board time " << b.last_stop_s()
               << " s; PWM now " << static_cast<int>(b.logic().left_pwm()) << "/"

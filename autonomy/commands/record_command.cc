@@ -1,18 +1,22 @@
 // `slamo record`: save a run as a TUM RGB-D folder and / or an MRPT rawlog (formats in
 // platform/RECORDING.md). With --sim the simulator drives a script on the whole field and
-// renders the camera; without it a real OpenNI2 camera is recorded (frames only: the motor
-// board's encoders are not wired into recording yet).
+// renders the camera; with --port DEV (or --fake-board) the board drives the script over its
+// serial link and its encoder ticks are recorded with the camera's frames (the OpenNI2
+// camera; with the fake board, the simulated field seen from its motors); with neither, a real
+// OpenNI2 camera alone is recorded.
 #include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "autonomy/commands/commands.h"
+#include "autonomy/robot_rig.h"
 #include "field_configs/config_error.h"
 #include "field_configs/loader.h"
 #include "platform/clock.h"
@@ -42,6 +46,38 @@ struct RecordArgs {
   std::string out;
   std::string format = "both";
   bool overwrite = false;
+  // The board (--port or --fake-board) and the camera with it (autonomy/robot_rig.h).
+  std::string port;
+  int baud = 115200;
+  bool fake_board = false;
+  std::string camera;
+};
+
+// Every frame and reading into each writer the format asked for, counted.
+class TeeWriter : public platform::RecordingWriter {
+ public:
+  explicit TeeWriter(std::vector<platform::RecordingWriter*> writers)
+      : writers_(std::move(writers)) {}
+  void AddFrame(const platform::RgbdFrame& frame) override {
+    for (auto* w : writers_) w->AddFrame(frame);
+    ++frames;
+  }
+  void AddEncoders(const platform::EncoderTicks& ticks) override {
+    for (auto* w : writers_) w->AddEncoders(ticks);
+    ++encoder_readings;
+  }
+  void AddGroundTruth(const platform::StampedPose& pose) override {
+    for (auto* w : writers_) w->AddGroundTruth(pose);
+    ++ground_truth_poses;
+  }
+  void Close() override {
+    for (auto* w : writers_) w->Close();
+  }
+  const std::string& path() const override { return writers_.front()->path(); }
+  int frames = 0, encoder_readings = 0, ground_truth_poses = 0;
+
+ private:
+  std::vector<platform::RecordingWriter*> writers_;
 };
 
 // "X,Y,THETA" in metres and degrees.
@@ -87,26 +123,28 @@ std::vector<std::unique_ptr<platform::RecordingWriter>> OpenWriters(
   return writers;
 }
 
-void PrintWritten(const RecordArgs& args) {
+void PrintWritten(const RecordArgs& args, bool truth, bool encoders) {
   if (WantTum(args)) {
-    std::printf("  TUM RGB-D folder: %s (rgb/, depth/, rgb.txt, depth.txt, %srecording.json)\n",
-                args.out.c_str(), args.sim ? "groundtruth.txt, encoders.txt, " : "");
+    std::printf("  TUM RGB-D folder: %s (rgb/, depth/, rgb.txt, depth.txt, %s%srecording.json)\n",
+                args.out.c_str(), truth ? "groundtruth.txt, " : "",
+                encoders ? "encoders.txt, " : "");
   }
   if (WantRawlog(args)) {
     std::printf("  MRPT rawlog:      %s\n", (fs::path(args.out) / kRawlogName).string().c_str());
   }
 }
 
+// The start pose: --pose, or the season's first starting tile.
+Pose2D StartFrom(const RecordArgs& args, const field::SeasonConfig& season) {
+  if (!args.pose.empty()) return ParsePose(args.pose);
+  const field::StartTile& tile = season.starts.front();
+  return Pose2D{tile.center_m.x, tile.center_m.y, tile.heading_deg * kPi / 180.0};
+}
+
 int RecordSim(const RecordArgs& args) {
   const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
   const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
-  Pose2D start;
-  if (args.pose.empty()) {
-    const field::StartTile& tile = season.starts.front();
-    start = Pose2D{tile.center_m.x, tile.center_m.y, tile.heading_deg * kPi / 180.0};
-  } else {
-    start = ParsePose(args.pose);
-  }
+  const Pose2D start = StartFrom(args, season);
   if (!platform::FootprintIsFree(season, start, robot.length_m, robot.width_m)) {
     std::cerr << "error: --pose " << args.pose
               << ": the robot does not fit there (wall or structure)\n";
@@ -178,7 +216,7 @@ int RecordSim(const RecordArgs& args) {
       static_cast<unsigned long long>(args.seed), summary.frames, args.fps,
       summary.encoder_readings, summary.ground_truth_poses,
       timed_out > 0 ? " (a step timed out)" : "");
-  PrintWritten(args);
+  PrintWritten(args, true, true);
   return 0;
 }
 
@@ -189,9 +227,9 @@ int RecordCamera(const RecordArgs& args) {
                  "OpenNI2 backend, and camera.model '"
               << robot.camera.model << "' in " << robot.source_file
               << " is not an OpenNI2 device (OpenNI2 drives " << platform::kOpenNI2Models
-              << "; a Kinect V2 needs libfreenect2, which slamo does not use). Encoder ticks "
-                 "also need the motor-controller board on its serial link. Use --sim to record "
-                 "the simulator.\n";
+              << "; a Kinect V2 needs libfreenect2, which slamo does not use). For encoder "
+                 "ticks give the board's serial device (--port DEV, or --fake-board); use --sim "
+                 "to record the simulator.\n";
     return 2;
   }
   if (!(args.fps > 0.0) || !(args.duration_s > 0.0)) {
@@ -235,7 +273,99 @@ int RecordCamera(const RecordArgs& args) {
     return 1;
   }
   std::printf("\nrecorded %d frames from %s\n", frames, robot.camera.model.c_str());
-  PrintWritten(args);
+  PrintWritten(args, false, false);
+  return 0;
+}
+
+// The board drives the script over its serial link with the drive controller the simulator
+// uses; the camera is grabbed at --fps and every control period's encoder ticks (and the truth,
+// on the fake board) are recorded on the run's clock (0 at the start).
+int RecordBoard(const RecordArgs& args) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
+  const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  std::vector<platform::DriveStep> steps;
+  Pose2D start;
+  try {
+    start = StartFrom(args, season);
+    steps = platform::ParseDriveScript(args.script);
+  } catch (const platform::DriveScriptError& e) {
+    std::cerr << "error: --script: " << e.what() << "\n";
+    return 2;
+  }
+  if (!(args.fps > 0.0 && args.fps <= 50.0)) {
+    std::cerr << "error: --fps must be in (0, 50]\n";
+    return 2;
+  }
+  RigOptions rig_options;
+  rig_options.port = args.port;
+  rig_options.baud = args.baud;
+  rig_options.fake_board = args.fake_board;
+  rig_options.camera = args.camera.empty() && args.fake_board ? "sim" : args.camera;
+  rig_options.seed = args.seed;
+  rig_options.io.frame_wait_s = 0.0;  // never hold up the drive controller for a frame
+  std::unique_ptr<Rig> rig;
+  std::vector<std::unique_ptr<platform::RecordingWriter>> writers;
+  std::unique_ptr<TeeWriter> tee;
+  try {
+    rig = std::make_unique<Rig>(rig_options, season, robot, start);
+    platform::RecordingInfo info = platform::RecordingInfoFor(robot);
+    info.source = args.fake_board ? "fake board" : "board";
+    info.description = "slamo record: board " + rig->board_name() + ", camera " +
+                       rig->camera_name() + ", script \"" + args.script + "\"";
+    writers = OpenWriters(args, info);
+    std::vector<platform::RecordingWriter*> raw;
+    for (const auto& w : writers) raw.push_back(w.get());
+    tee = std::make_unique<TeeWriter>(raw);
+    rig->SetRecorder(tee.get());
+    rig->Connect();
+  } catch (const RigError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return e.exit_status;
+  } catch (const platform::RecordingError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  std::unique_ptr<HardwareIo> io = rig->TakeIo();
+  io->Start(season, robot, start);
+  const double period_s = 1.0 / args.fps;
+  double next_frame_s = 0.0;
+  const auto grab = [&]() {
+    if (io->clock().NowS() + 1e-9 < next_frame_s) return;
+    io->Capture();
+    next_frame_s += period_s;
+  };
+  platform::DriveBodyLink body = DriveLinkFor(*io, robot);
+  body.advance = [&](double dt_s) {
+    io->Advance(dt_s);
+    grab();
+  };
+  std::vector<platform::DriveStepResult> results;
+  try {
+    grab();
+    results =
+        platform::RunDriveScript(steps, platform::DriveControllerOptionsFor(robot.drive), body);
+    io->drive().Stop();
+    io->Advance(0.1);
+    tee->Close();
+  } catch (const platform::RecordingError& e) {
+    io->drive().Stop();
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  } catch (const platform::CameraError& e) {
+    io->drive().Stop();
+    std::cerr << "error: the camera failed: " << e.what() << "\n";
+    return 3;
+  }
+  int timed_out = 0;
+  for (const auto& r : results) timed_out += r.status != platform::DriveStepStatus::kDone;
+  const std::map<std::string, double> status = io->Status();
+  std::printf(
+      "recorded %.2f s of %s driving \"%s\" on %s: %d frames, %d encoder readings, %d "
+      "ground-truth poses; link losses %.0f%s\n",
+      io->clock().NowS(), rig->board_name().c_str(), args.script.c_str(), robot.name.c_str(),
+      tee->frames, tee->encoder_readings, tee->ground_truth_poses, status.at("link_losses"),
+      timed_out > 0 ? " (a step timed out)" : "");
+  PrintWritten(args, tee->ground_truth_poses > 0, true);
   return 0;
 }
 
@@ -248,7 +378,8 @@ void RegisterRecordCommand(CLI::App& app, CommandAction* action) {
       "Record a run (colour, depth, encoders, truth) as a TUM RGB-D folder and an MRPT rawlog.   "
       "e.g. slamo record --sim --script \"forward 0.3; turn 90\" --out DIR");
   record->add_flag("--sim", args->sim,
-                   "record the simulator driving --script (without it: a real OpenNI2 camera)");
+                   "record the simulator driving --script (without it: the board with --port or "
+                   "--fake-board, else a real OpenNI2 camera alone)");
   record->add_option("--season", args->season, "season name or .yaml file (--sim)")
       ->capture_default_str();
   record->add_option("--robot", args->robot, "robot name or .yaml file")->capture_default_str();
@@ -271,8 +402,21 @@ void RegisterRecordCommand(CLI::App& app, CommandAction* action) {
       ->capture_default_str();
   record->add_flag("--overwrite", args->overwrite,
                    "replace a recording already in the output folder");
+  record->add_option("--port", args->port,
+                     "the motor-controller board's serial device: it drives --script and its "
+                     "encoder ticks are recorded with the camera");
+  record->add_option("--baud", args->baud, "serial speed")->capture_default_str();
+  record->add_flag("--fake-board", args->fake_board,
+                   "the fake board on a pseudo-terminal in this process, on simulated time "
+                   "(camera: the simulated field seen from its motors)");
+  record->add_option("--camera", args->camera,
+                     "with --port or --fake-board: openni2 | sim (fake board only)");
   record->callback([action, args] {
-    *action = [args] { return args->sim ? RecordSim(*args) : RecordCamera(*args); };
+    *action = [args] {
+      if (args->sim) return RecordSim(*args);
+      if (!args->port.empty() || args->fake_board) return RecordBoard(*args);
+      return RecordCamera(*args);
+    };
   });
 }
 

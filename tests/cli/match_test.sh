@@ -1,7 +1,8 @@
 #!/bin/sh
 # slamo match with no robot: the fake board on a pseudo-terminal (the whole serial stack over
-# it) and a recorded camera stream, on a 15 s copy of Toss Up; then with a noisy link and the
-# cable pulled mid-match; and the exit statuses for bad input.
+# it) and a recorded camera stream, on a 15 s copy of Toss Up; with the simulated camera and
+# --record, replayed by dry-run --from-recording; slamo record on the fake board; a noisy link
+# with the cable pulled mid-match; and the exit statuses for bad input.
 set -eu
 slamo="$1"
 dir="$2"
@@ -42,6 +43,21 @@ assert live["pose_ate_m"] is not None and live["pose_ate_m"] < 0.2, live["pose_a
 assert replayed["pose_ate_m"] is not None and replayed["pose_ate_m"] < 0.2, replayed["pose_ate_m"]
 assert replayed["frames_taken"] == live["frames_taken"], (replayed["frames_taken"], live["frames_taken"])
 PY
+
+# slamo record on the fake board: the board drives the script over the serial link, its
+# encoder ticks are recorded with the frames (both formats), and SLAM-O replays them.
+"$slamo" record --fake-board --script "forward 0.3; turn 45" --out "$dir/boardrec" > "$dir/boardrec.txt"
+test -s "$dir/boardrec/recording.rawlog" || { echo "no rawlog"; exit 1; }
+test "$(grep -vc '^#' "$dir/boardrec/encoders.txt")" -gt 100 || { echo "few encoder readings"; exit 1; }
+for rec in "$dir/boardrec" "$dir/boardrec/recording.rawlog"; do
+  "$slamo" dry-run --from-recording "$rec" --out "$dir/boardreplay" > /dev/null
+  python3 - "$dir/boardreplay/report.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["pose_ate_m"] is not None and r["pose_ate_m"] < 0.1, r["pose_ate_m"]
+assert r["frames_taken"] > 20, r["frames_taken"]
+PY
+done
 
 # A noisy link and the cable out for half a second: the match goes on and ends stopped.
 "$slamo" match --fake-board --recording "$dir/rec" --loop --season "$dir/toss_up_15.yaml" \
