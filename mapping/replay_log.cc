@@ -160,27 +160,6 @@ class TextLogReader {
 
 double ToSeconds(mrpt::Clock::time_point t) { return mrpt::Clock::toDouble(t); }
 
-// The gist of an exception message: MRPT's have a banner, then `Message:` and `Location:` lines
-// (either may be empty), then a call stack.
-std::string FirstLine(const std::string& text) {
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) {
-    if (line.rfind("====", 0) == 0 || line.rfind("Call stack", 0) == 0) continue;
-    for (const char* label : {"Message:", "Location:"}) {
-      if (line.rfind(label, 0) == 0) line.erase(0, std::string(label).size());
-    }
-    const auto first = line.find_first_not_of(" \t");
-    if (first == std::string::npos) continue;
-    // A garbled file yields garbled class names: keep the message printable and short.
-    std::string gist = line.substr(first, 160);
-    for (char& c : gist) {
-      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-    }
-    return gist;
-  }
-  return "no message";
-}
-
 class RawlogReader {
  public:
   RawlogReader(const std::string& path, const ReplayLogOptions& options)
@@ -197,7 +176,7 @@ class RawlogReader {
     } catch (const ReplayLogError&) {
       throw;
     } catch (const std::exception& e) {
-      throw ReplayLogError(path_ + ": cannot open (" + FirstLine(e.what()) + ")");
+      throw ReplayLogError(path_ + ": cannot open (" + platform::MrptErrorGist(e.what()) + ")");
     }
     auto archive = mrpt::serialization::archiveFrom(file);
     for (record_ = 1;; ++record_) {
@@ -209,7 +188,7 @@ class RawlogReader {
         if (file.getPosition() == before) break;  // a clean end between records
         throw Error("truncated (the file ends inside it)");
       } catch (const std::exception& e) {
-        throw Error("not a valid MRPT rawlog record (" + FirstLine(e.what()) + ")");
+        throw Error("not a valid MRPT rawlog record (" + platform::MrptErrorGist(e.what()) + ")");
       }
       if (!object) throw Error("an empty (null) object");
       Add(*object);

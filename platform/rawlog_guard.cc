@@ -12,6 +12,7 @@
 #include <exception>
 #include <fstream>
 #include <new>
+#include <sstream>
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/serialization/CArchive.h>
@@ -78,6 +79,25 @@ void LimitAddressSpace() {
 }
 
 }  // namespace
+
+std::string MrptErrorGist(const std::string& text) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("====", 0) == 0 || line.rfind("Call stack", 0) == 0) continue;
+    for (const char* label : {"Message:", "Location:"}) {
+      if (line.rfind(label, 0) == 0) line.erase(0, std::string(label).size());
+    }
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos) continue;
+    // A garbled file yields garbled class names: keep the message printable and short.
+    std::string gist = line.substr(first, 160);
+    for (char& c : gist) {
+      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    }
+    return gist;
+  }
+  return "no message";
+}
 
 std::optional<std::string> CheckRawlogInChildProcess(const std::string& path, double timeout_s) {
   int fds[2];

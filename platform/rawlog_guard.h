@@ -20,4 +20,10 @@ namespace slamo::platform {
 std::optional<std::string> CheckRawlogInChildProcess(const std::string& path,
                                                      double timeout_s = 120.0);
 
+// The gist of an MRPT exception message, for an error of ours: MRPT's have a banner, then
+// `Message:` and `Location:` lines (either may be empty), then a call stack. The first line
+// with content, printable and at most 160 characters (a garbled file yields garbled class
+// names); "no message" when there is none.
+std::string MrptErrorGist(const std::string& what);
+
 }  // namespace slamo::platform

@@ -690,25 +690,6 @@ class TumReader : public RecordingReader {
 
 // ---- MRPT rawlog: reader ----
 
-// The gist of an MRPT exception message (a banner, `Message:` / `Location:`, a call stack).
-std::string Gist(const std::string& text) {
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) {
-    if (line.rfind("====", 0) == 0 || line.rfind("Call stack", 0) == 0) continue;
-    for (const char* label : {"Message:", "Location:"}) {
-      if (line.rfind(label, 0) == 0) line.erase(0, std::string(label).size());
-    }
-    const auto first = line.find_first_not_of(" \t");
-    if (first == std::string::npos) continue;
-    std::string gist = line.substr(first, 160);
-    for (char& c : gist) {
-      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-    }
-    return gist;
-  }
-  return "no message";
-}
-
 // Reads a rawlog's records in order and hands out their observations (sensory frames and
 // nested rawlogs flattened; actions skipped).
 class RawlogStream {
@@ -723,7 +704,7 @@ class RawlogStream {
     try {
       ok = file_.open(path_);
     } catch (const std::exception& e) {
-      throw RecordingError(path_ + ": cannot open (" + Gist(e.what()) + ")");
+      throw RecordingError(path_ + ": cannot open (" + MrptErrorGist(e.what()) + ")");
     }
     if (!ok) throw RecordingError(path_ + ": cannot open");
     archive_ = mrpt::serialization::archiveUniquePtrFrom(file_);
@@ -741,7 +722,7 @@ class RawlogStream {
         if (file_.getPosition() == before) return nullptr;  // a clean end between records
         throw Error("truncated (the file ends inside it)");
       } catch (const std::exception& e) {
-        throw Error("not a valid MRPT rawlog record (" + Gist(e.what()) + ")");
+        throw Error("not a valid MRPT rawlog record (" + MrptErrorGist(e.what()) + ")");
       }
       if (!object) throw Error("an empty (null) object");
       Add(object);
