@@ -274,7 +274,7 @@ class RawlogReader {
       const double rho = p.norm();
       if (!std::isfinite(rho) || rho < 1e-6) continue;  // at the centre: no bearing
       Eigen::Matrix2d sensor_covariance;
-      if (o.validCovariances) {
+      if (platform::StoredBool(o.validCovariances)) {
         sensor_covariance << m.covariance(0, 0), m.covariance(0, 1), m.covariance(1, 0),
             m.covariance(1, 1);
       } else {

@@ -153,4 +153,11 @@ std::optional<std::string> CheckRawlogInChildProcess(const std::string& path, do
   return std::nullopt;
 }
 
+bool StoredBool(const bool& flag) {
+  unsigned char byte = 0;
+  static_assert(sizeof(bool) == sizeof(byte), "a bool is one byte");
+  std::memcpy(&byte, &flag, sizeof(byte));
+  return byte != 0;
+}
+
 }  // namespace slamo::platform

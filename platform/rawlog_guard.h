@@ -26,4 +26,10 @@ std::optional<std::string> CheckRawlogInChildProcess(const std::string& path,
 // names); "no message" when there is none.
 std::string MrptErrorGist(const std::string& what);
 
+// A bool member as MRPT deserialised it. MRPT reads the file's byte straight into the bool, so
+// a corrupt rawlog can leave a value other than 0 or 1 there, and loading such a bool is
+// undefined behaviour (UBSan: "load of value 78, which is not a valid value for type 'bool'").
+// This reads the byte instead: any non-zero byte is true. Use it for every bool a rawlog set.
+bool StoredBool(const bool& flag);
+
 }  // namespace slamo::platform

@@ -764,14 +764,25 @@ double Seconds(mrpt::Clock::time_point t) { return mrpt::Clock::toDouble(t); }
 
 // A 3D range scan as an RgbdFrame; throws through `stream` naming the record.
 RgbdFrame ToFrame(const mrpt::obs::CObservation3DRangeScan& scan, const RawlogStream& stream) {
-  if (!scan.hasRangeImage) throw stream.Error("a 3D range scan without a depth image");
-  if (scan.rangeImage_isExternallyStored() || scan.intensityImage.isExternallyStored()) {
+  // Every bool below was read from the file: StoredBool (rawlog_guard.h). MRPT's own
+  // isExternallyStored() accessors load such bools too (one is private), so external storage
+  // is told by what MRPT read instead: a file name, and no depth image in the record.
+  if (!StoredBool(scan.hasRangeImage)) {
+    throw stream.Error("a 3D range scan without a depth image");
+  }
+  if (!scan.intensityImage.getExternalStorageFile().empty()) {
     throw stream.Error("a 3D range scan with externally stored images (not supported)");
   }
-  if (!scan.range_is_depth) {
+  if (scan.rangeImage.rows() == 0 || scan.rangeImage.cols() == 0) {
+    throw stream.Error(
+        "a 3D range scan with an empty depth image (or one stored externally: not supported)");
+  }
+  if (!StoredBool(scan.range_is_depth)) {
     throw stream.Error("a 3D range scan of ranges, not depth along the axis (not supported)");
   }
-  if (!scan.hasIntensityImage) throw stream.Error("a 3D range scan without an intensity image");
+  if (!StoredBool(scan.hasIntensityImage)) {
+    throw stream.Error("a 3D range scan without an intensity image");
+  }
   RgbdFrame frame;
   frame.t_s = Seconds(scan.timestamp);
   const int rows = static_cast<int>(scan.rangeImage.rows());
@@ -842,7 +853,7 @@ class RawlogReader : public RecordingReader {
         ++frame_count_;
       } else if (const auto* odometry =
                      dynamic_cast<const mrpt::obs::CObservationOdometry*>(o.get())) {
-        if (!odometry->hasEncodersInfo) continue;
+        if (!StoredBool(odometry->hasEncodersInfo)) continue;
         const EncoderTicks ticks{Seconds(odometry->timestamp), odometry->encoderLeftTicks,
                                  odometry->encoderRightTicks};
         if (!encoders_.empty() && ticks.t_s < encoders_.back().t_s) {

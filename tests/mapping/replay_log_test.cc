@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -271,6 +272,56 @@ TEST(RawlogTest, BearingRangeIsMovedFromTheSensorToTheRobotCentre) {
   // Along the line of sight: range sigma unchanged; across it, 1 m of arc at 1.2 m.
   EXPECT_NEAR(z.covariance(0, 0), 0.01, 1e-7);
   EXPECT_NEAR(std::sqrt(z.covariance(1, 1)), 0.05 / 1.2, 1e-7);
+}
+
+// The bytes of an uncompressed rawlog of one bearing-range observation with a covariance.
+std::string BearingRangeRawlogBytes(bool valid_covariances) {
+  const std::string path = TempPath("flag.rawlog");
+  {
+    mrpt::io::CFileOutputStream file(path);
+    auto archive = mrpt::serialization::archiveFrom(file);
+    mrpt::obs::CObservationBearingRange o;
+    o.timestamp = mrpt::Clock::fromDouble(1.0);
+    o.validCovariances = valid_covariances;
+    o.sensor_std_range = 0.1f;
+    o.sensor_std_yaw = 0.05f;
+    mrpt::obs::CObservationBearingRange::TMeasurement m;
+    m.range = 2.0f;
+    m.landmarkID = 3;
+    m.covariance.setZero();
+    m.covariance(0, 0) = 0.04;
+    m.covariance(1, 1) = 0.0009;
+    m.covariance(2, 2) = 0.0009;
+    o.sensedData.push_back(m);
+    archive << o;
+  }
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// MRPT reads a bool's byte from the file into the bool unchecked (found by
+// replay_rawlog_fuzzer: "load of value 78, which is not a valid value for type 'bool'" under
+// UBSan). Any non-zero byte means true, and the sanitizer build stays quiet.
+TEST(RawlogTest, AFlagByteOtherThanZeroOrOneReadsAsTrue) {
+  // MRPT writes the flag, then the sensor's sigmas (flag off) or each entry's covariance (on):
+  // the first byte where the two files differ is the flag's.
+  const std::string off = BearingRangeRawlogBytes(false);
+  std::string corrupt = BearingRangeRawlogBytes(true);
+  const size_t flag = static_cast<size_t>(
+      std::mismatch(off.begin(), off.end(), corrupt.begin(), corrupt.end()).first - off.begin());
+  ASSERT_LT(flag, off.size());
+  ASSERT_EQ(off[flag], 0);
+  ASSERT_EQ(corrupt[flag], 1);
+  corrupt[flag] = 78;
+  const std::string path = TempPath("flag78.rawlog");
+  WriteFile(path, corrupt);
+  const ReplayLog log = ReadRawlog(path);
+  ASSERT_EQ(log.events.size(), 1u);
+  const RangeBearing& z = log.events[0].measurement();
+  EXPECT_EQ(z.id, 3);
+  // The file's covariance (0.2 m, 0.03 rad), not the sensor's sigmas (0.1 m, 0.05 rad).
+  EXPECT_NEAR(z.covariance(0, 0), 0.04, 1e-9);
+  EXPECT_NEAR(z.covariance(1, 1), 0.0009, 1e-9);
 }
 
 void ExpectRawlogError(const std::string& path, const std::string& says) {

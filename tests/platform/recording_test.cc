@@ -7,12 +7,19 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include <mrpt/core/Clock.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -474,6 +481,62 @@ TEST(RecordingTest, BadRawlogs) {
                             "/tests/fuzz/known_crashes/mrpt_action_robot_movement_2d_segv.rawlog";
   ExpectRecordingError([&] { OpenRawlogRecording(crash); },
                        {crash, "MRPT's rawlog deserialiser", "record 1"});
+}
+
+// A rawlog of one 4x3 scan, changed by `change` before it is written.
+void WriteScanRawlog(const std::string& path,
+                     const std::function<void(mrpt::obs::CObservation3DRangeScan&)>& change) {
+  mrpt::obs::CObservation3DRangeScan scan;
+  scan.timestamp = mrpt::Clock::fromDouble(1.0);
+  scan.hasRangeImage = true;
+  scan.range_is_depth = true;
+  scan.rangeUnits = 0.001f;
+  scan.rangeImage_setSize(3, 4);
+  scan.rangeImage.fill(1000);
+  scan.hasIntensityImage = true;
+  scan.intensityImage =
+      mrpt::img::CImage(cv::Mat(3, 4, CV_8UC3, cv::Scalar(1, 2, 3)), mrpt::img::DEEP_COPY);
+  change(scan);
+  scan.cameraParams.ncols = static_cast<uint32_t>(scan.rangeImage.cols());
+  scan.cameraParams.nrows = static_cast<uint32_t>(scan.rangeImage.rows());
+  scan.cameraParamsIntensity = scan.cameraParams;
+  mrpt::io::CFileGZOutputStream file(path);
+  auto archive = mrpt::serialization::archiveFrom(file);
+  archive << scan;
+}
+
+TEST(RecordingTest, RawlogScansOtherThanRegisteredDepthAndColourAreRejected) {
+  const TempPath dir_tmp("scan_rawlogs");
+  const std::string& dir = dir_tmp.str();
+  fs::create_directories(dir);
+  const std::string good = dir + "/good.rawlog";
+  WriteScanRawlog(good, [](auto&) {});
+  auto reader = OpenRawlogRecording(good);
+  const std::optional<RgbdFrame> frame = reader->Grab();
+  ASSERT_TRUE(frame.has_value());
+  EXPECT_EQ(frame->depth_mm.at<uint16_t>(2, 3), 1000);
+  EXPECT_EQ(frame->colour.at<cv::Vec3b>(2, 3), cv::Vec3b(1, 2, 3));
+
+  const std::vector<
+      std::pair<std::function<void(mrpt::obs::CObservation3DRangeScan&)>, std::string>>
+      cases = {
+          {[](auto& s) { s.hasRangeImage = false; }, "without a depth image"},
+          {[](auto& s) { s.rangeImage_setSize(0, 0); }, "an empty depth image"},
+          {[](auto& s) { s.range_is_depth = false; }, "of ranges, not depth"},
+          {[](auto& s) { s.hasIntensityImage = false; }, "without an intensity image"},
+          {[](auto& s) { s.intensityImage.setExternalStorage("elsewhere.png"); },
+           "externally stored images"},
+          {[](auto& s) {
+             s.intensityImage =
+                 mrpt::img::CImage(cv::Mat(2, 4, CV_8UC3, cv::Scalar(0)), mrpt::img::DEEP_COPY);
+           },
+           "colour must be registered to depth"},
+      };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const std::string path = dir + "/bad" + std::to_string(i) + ".rawlog";
+    WriteScanRawlog(path, cases[i].first);
+    ExpectRecordingError([&] { OpenRawlogRecording(path); }, {path, "record 1", cases[i].second});
+  }
 }
 
 // ---- The simulator as the recorder ----
