@@ -8,6 +8,14 @@
 #include <string>
 #include <vector>
 
+#include <mrpt/core/Clock.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/obs/CObservationBearingRange.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/serialization/CArchive.h>
+
 #include "mapping/replay_log.h"
 #include "platform/serial_protocol.h"
 
@@ -72,7 +80,41 @@ int main(int argc, char** argv) {
     log.events.push_back(obs);
   }
   slamo::mapping::WriteTextLog((dir / "replay_text" / "run.log").string(), log);
-  slamo::mapping::WriteRawlog((dir / "replay_rawlog" / "run.rawlog").string(), log);
+  const fs::path rawlog = dir / "replay_rawlog" / "run.rawlog";
+  slamo::mapping::WriteRawlog(rawlog.string(), log);
+  // The same records uncompressed (MRPT reads both): mutations of the gzip stream mostly
+  // exercise zlib's checks, of these the deserialisers.
+  {
+    mrpt::io::CFileGZInputStream in(rawlog.string());
+    std::vector<uint8_t> bytes;
+    uint8_t buffer[4096];
+    for (size_t n; (n = in.Read(buffer, sizeof(buffer))) > 0;) {
+      bytes.insert(bytes.end(), buffer, buffer + n);
+    }
+    WriteBytes((dir / "replay_rawlog" / "run_plain.rawlog").string(), bytes);
+  }
+  // The observations-only layout, uncompressed: absolute odometry, and a bearing-range
+  // observation with per-landmark covariances.
+  {
+    mrpt::io::CFileOutputStream out((dir / "replay_rawlog" / "observations.rawlog").string());
+    auto archive = mrpt::serialization::archiveFrom(out);
+    mrpt::obs::CObservationOdometry odometry;
+    odometry.timestamp = mrpt::Clock::fromDouble(1.0);
+    odometry.odometry = mrpt::poses::CPose2D(0.3, 0.1, 0.2);
+    archive << odometry;
+    mrpt::obs::CObservationBearingRange o;
+    o.timestamp = mrpt::Clock::fromDouble(1.5);
+    o.validCovariances = true;
+    mrpt::obs::CObservationBearingRange::TMeasurement m;
+    m.range = 1.5f;
+    m.yaw = 0.2f;
+    m.landmarkID = 4;
+    m.covariance.setZero();
+    m.covariance(0, 0) = 0.01;
+    m.covariance(1, 1) = 0.0004;
+    o.sensedData.push_back(m);
+    archive << o;
+  }
   std::ofstream((dir / "replay_text" / "velocity.log").string())
       << "# velocity form\nstart 0 0 0\nodom 0.0 0.1 0.0\nodom 1.0 0.1 0.5\n"
          "obs 1.5 -1 2.0 0.1 0.05 0.01\n";
