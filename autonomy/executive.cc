@@ -171,6 +171,9 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
       case ActionKind::kScore:
         ok = world.Score(action);
         break;
+      case ActionKind::kDrop:
+        ok = world.Drop(action);
+        break;
       case ActionKind::kIdle:
         break;
     }

@@ -178,7 +178,9 @@ std::optional<ReleaseOutcome> HardwareIo::Release(int intended_goal) {
   if (!held_) return std::nullopt;
   held_ = false;
   ++releases_assumed_;
-  return ReleaseOutcome{intended_goal, true};
+  // Taken on trust: where it was aimed (the floor, for a drop).
+  return ReleaseOutcome{intended_goal >= 0 ? std::optional<int>(intended_goal) : std::nullopt,
+                        true};
 }
 
 std::string HardwareIo::Describe() const {

@@ -634,14 +634,18 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   Wait(context_.robot ? setup_.strategy_options.pick_s : 1.0);
   if (!picked) return false;
   // The intake knows what it took (kind and colour from its own sensor, or taken on trust).
+  // Another kind or colour than the target's: the intake took a neighbour, and the target is
+  // still on the field (the tracker lets the one taken fade from view).
+  const bool took_target =
+      target.kind.empty() || (picked->kind == target.kind && picked->colour == target.colour);
   strategy::ObjectBelief held;
-  held.id = action.object_id;
+  held.id = took_target ? action.object_id : -1;
   held.kind = picked->kind;
   held.colour = picked->colour;
   held_ = held;
-  if (action.object_id >= 0) picked_ids_.push_back(action.object_id);
+  if (took_target && action.object_id >= 0) picked_ids_.push_back(action.object_id);
   UpdateMaps();
-  return true;
+  return took_target;
 }
 
 bool MatchWorld::Score(const strategy::Action& action) {
@@ -675,6 +679,18 @@ bool MatchWorld::Score(const strategy::Action& action) {
   if (!released) return false;
   held_.reset();
   return released->goal_index && *released->goal_index == action.goal_index;
+}
+
+bool MatchWorld::Drop(const strategy::Action& action) {
+  if (!held_) return false;
+  TurnTo(action.target.z());
+  if (now_s() >= deadline_s_) return false;
+  // No back-off as after a score: nothing presses against the robot here.
+  const std::optional<ReleaseOutcome> released = io_->Release(-1);
+  Wait(setup_.strategy_options.release_s);
+  if (!released) return false;
+  held_.reset();
+  return true;
 }
 
 void MatchWorld::IdleToDeadline() {

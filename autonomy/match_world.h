@@ -116,10 +116,15 @@ class MatchWorld {
   // Gives up (false) when it has taken budget_s (<= 0: no limit).
   bool Navigate(const Eigen::Vector3d& target, double stop_spacing_m, int frames_per_stop,
                 double budget_s = 0.0);
-  // Final approach to an object believed at target.xy and the intake.
+  // Final approach to an object believed at target.xy and the intake; true when the intake
+  // took an object of the target's kind and colour (another one is held, but the pick
+  // failed).
   bool Pick(const strategy::Action& action);
   // Final approach to the goal and the release; true when the object landed where intended.
   bool Score(const strategy::Action& action);
+  // Turns to action.target's heading and releases the held object there, on the floor;
+  // true when it left the intake.
+  bool Drop(const strategy::Action& action);
   // Stands still until the deadline.
   void IdleToDeadline();
 

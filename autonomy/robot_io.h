@@ -60,7 +60,8 @@ class RobotIo {
   virtual std::optional<platform::RgbdFrame> Capture() = 0;
   // The intake, in front of `target`; nothing when it took nothing.
   virtual std::optional<IntakeItem> Pick(const strategy::ObjectBelief& target) = 0;
-  // The release, aimed at goal `intended_goal`; nothing when nothing left the intake.
+  // The release, aimed at goal `intended_goal` (-1: dropped on the floor); nothing when
+  // nothing left the intake.
   virtual std::optional<ReleaseOutcome> Release(int intended_goal) = 0;
   // What was loaded by hand before the match.
   virtual std::optional<IntakeItem> Preload() const = 0;

@@ -261,6 +261,42 @@ class Base : public Strategy {
     return a;
   }
 
+  // A held object that scores in no goal for us (the intake took another object than the one
+  // aimed at; the intake says what it holds) blocks every pick for the rest of the match:
+  // release it where the robot stands.
+  std::optional<Action> DropUseless(const Belief& b, const StrategyContext& c) const {
+    if (!b.held) return std::nullopt;
+    for (int g = 0; g < static_cast<int>(c.season->goals.size()); ++g) {
+      if (GoalPoints(*c.season, g, b.held->kind, b.held->colour, c.alliance) > 0) {
+        return std::nullopt;
+      }
+    }
+    // Turned aside first: dropped straight ahead it would lie where the intake just took it,
+    // in front of the object the pick was aimed at. To the side whose drop point is clear
+    // and farthest from the objects of ours.
+    const double r = ObjectRadius(*c.season, b.held->kind);
+    const double reach = ReleaseDistance(*c.robot, r);
+    double best_heading = b.pose.z() + kPi / 2.0, best_room = -1.0;
+    for (const double turn : {kPi / 2.0, -kPi / 2.0, kPi}) {
+      const double heading = Wrap(b.pose.z() + turn);
+      const Eigen::Vector2d drop =
+          b.pose.head<2>() + reach * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+      if (!c.is_clear(drop)) continue;
+      double room = 10.0;
+      for (const ObjectBelief& o : b.objects) {
+        if (Scores(c, o)) room = std::min(room, (o.position_m - drop).norm());
+      }
+      if (room > best_room + 1e-9) best_room = room, best_heading = heading;
+    }
+    Action a;
+    a.kind = ActionKind::kDrop;
+    a.target = Eigen::Vector3d(b.pose.x(), b.pose.y(), best_heading);
+    const double turn_deg = std::abs(Wrap(best_heading - b.pose.z())) * 180.0 / kPi;
+    a.expected_s = turn_deg / c.robot->drive.turn_rate_dps + options_.release_s;
+    a.why = b.held->colour + " " + b.held->kind + " scores nothing for us: free the intake";
+    return a;
+  }
+
   // Turn to look where the season places objects of our colour and none is tracked yet.
   std::optional<Action> Look(const Belief& b, const StrategyContext& c) {
     std::vector<Eigen::Vector2d> prior;
@@ -339,6 +375,10 @@ class PlannerStrategy : public Base {
       a.why = "initial survey";
       return a;
     }
+    if (std::optional<Action> drop = DropUseless(b, c)) {
+      just_observed_ = false;
+      return *drop;
+    }
     Cycle best;
     double best_j = 0.0, best_rate = 0.0;
     const auto consider = [&](const Cycle& first, double j, double seconds) {
@@ -409,6 +449,7 @@ class GreedyStrategy : public Base {
       a.why = "initial survey";
       return a;
     }
+    if (std::optional<Action> drop = DropUseless(b, c)) return *drop;
     std::optional<Cycle> chosen;
     const double left = b.deadline_s - b.now_s;
     if (b.held) {
@@ -579,6 +620,8 @@ const char* ActionName(ActionKind kind) {
       return "PICK";
     case ActionKind::kScore:
       return "SCORE";
+    case ActionKind::kDrop:
+      return "DROP";
     case ActionKind::kIdle:
       return "IDLE";
   }

@@ -1,6 +1,6 @@
 // The scheduler that spends the autonomous seconds: from what SLAM-O believes (pose and its
 // covariance, tracked objects and their confidence), the time left and travel times from the
-// planner, it chooses the robot's next action: OBSERVE, NAVIGATE, PICK or SCORE.
+// planner, it chooses the robot's next action: OBSERVE, NAVIGATE, PICK, SCORE or DROP.
 //
 // Our method ("planner"): a receding-horizon search. Every time an action ends, it enumerates
 // the sequences of up to `horizon` pick-and-score cycles (the held object's scoring first, if
@@ -59,7 +59,9 @@ struct Belief {
   std::vector<ObjectBelief> objects;  // confirmed objects on the field
 };
 
-enum class ActionKind { kObserve, kNavigate, kPick, kScore, kIdle };
+// kDrop: release the held object where the robot stands, because no goal takes it for our
+// alliance (the intake took another object than the one aimed at): it frees the intake.
+enum class ActionKind { kObserve, kNavigate, kPick, kScore, kDrop, kIdle };
 const char* ActionName(ActionKind kind);
 
 struct Action {

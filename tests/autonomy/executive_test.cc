@@ -84,6 +84,29 @@ class FarAway : public strategy::Strategy {
   double claimed_s_;
 };
 
+// A held object no goal takes for us is released at once, on the field's own intake: here
+// the season is changed so that buckyballs score nothing, and the robot starts with one.
+TEST(Executive, AnObjectThatScoresNothingIsDroppedToFreeTheIntake) {
+  field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  season.rules.autonomous_s = 10.0;
+  for (field::Goal& g : season.goals) g.points.erase("buckyball");
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  for (const std::string strategy : {"planner", "greedy"}) {
+    MatchSetup setup;
+    setup.strategy = strategy;
+    const MatchResult r = RunMatch(season, robot, setup, 1);
+    ASSERT_GE(r.timeline.size(), 3u) << strategy;
+    EXPECT_EQ(r.timeline[0].action, "OBSERVE") << strategy;  // the initial survey
+    EXPECT_EQ(r.timeline[1].action, "DROP") << strategy;
+    EXPECT_TRUE(r.timeline[1].ok) << strategy;
+    // A turn aside and the release: no drive to anywhere first.
+    EXPECT_LE(r.timeline[1].end_s - r.timeline[1].t_s, r.timeline[1].expected_s + 0.5) << strategy;
+    for (size_t i = 2; i < r.timeline.size(); ++i) {
+      EXPECT_NE(r.timeline[i].action, "DROP") << strategy << ": the intake is empty";
+    }
+  }
+}
+
 TEST(Executive, ActionThatWouldOverrunIsNotStarted) {
   field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
   season.rules.autonomous_s = 5.0;

@@ -109,6 +109,36 @@ TEST_F(StrategyTest, PlannerScoresTheHeldObjectAndIdlesWhenNothingFits) {
   EXPECT_EQ(planner->Next(b, context_).kind, ActionKind::kIdle);
 }
 
+// The intake took a neighbour of the other alliance's colour: no goal takes it for red, so
+// every perceiving strategy drops it at once instead of carrying it to the deadline (seed 3
+// of the Toss Up dry run held one for 25 s).
+TEST_F(StrategyTest, AHeldObjectThatScoresNothingForUsIsDropped) {
+  for (const std::string name : {"planner", "greedy", "thesis"}) {
+    std::unique_ptr<Strategy> strategy = MakeStrategy(name, StrategyOptions{});
+    Belief b;
+    b.pose = Eigen::Vector3d(-1.0, 0.3, 0.5);
+    b.held = ObjectBelief{-1, "buckyball", "blue", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(),
+                          1.0};
+    b.objects.push_back(ObjectBelief{4, "buckyball", "red", Eigen::Vector2d(-0.5, -0.6),
+                                     Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    EXPECT_EQ(strategy->Next(b, context_).kind, ActionKind::kObserve) << name;  // survey
+    const Action drop = strategy->Next(b, context_);
+    EXPECT_EQ(drop.kind, ActionKind::kDrop) << name;
+    EXPECT_STREQ(ActionName(drop.kind), "DROP");
+    // Turned aside, so that the next pick does not take it again.
+    EXPECT_GT(std::abs(std::remainder(drop.target.z() - b.pose.z(), 2 * M_PI)), 1.5) << name;
+    // Dropped: the red ball is next.
+    b.held.reset();
+    const Action next = strategy->Next(b, context_);
+    EXPECT_NE(next.kind, ActionKind::kDrop) << name;
+    EXPECT_NE(next.kind, ActionKind::kIdle) << name;
+    // A red ball in the intake is kept and scored.
+    b.held =
+        ObjectBelief{-1, "buckyball", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
+    EXPECT_NE(strategy->Next(b, context_).kind, ActionKind::kDrop) << name;
+  }
+}
+
 TEST_F(StrategyTest, UnknownStrategyIsAnError) {
   EXPECT_THROW(MakeStrategy("random", StrategyOptions{}), std::invalid_argument);
   for (const std::string& name : StrategyNames())
