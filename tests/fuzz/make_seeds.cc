@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
     mrpt::obs::CObservationBearingRange::TMeasurement m;
     m.range = 1.5f;
     m.yaw = 0.2f;
+    m.pitch = 0.0f;  // MRPT leaves a measurement's fields uninitialised
     m.landmarkID = 4;
     m.covariance.setZero();
     m.covariance(0, 0) = 0.01;

@@ -287,6 +287,8 @@ std::string BearingRangeRawlogBytes(bool valid_covariances) {
     o.sensor_std_yaw = 0.05f;
     mrpt::obs::CObservationBearingRange::TMeasurement m;
     m.range = 2.0f;
+    m.yaw = 0.0f;  // MRPT leaves a measurement's fields uninitialised
+    m.pitch = 0.0f;
     m.landmarkID = 3;
     m.covariance.setZero();
     m.covariance(0, 0) = 0.04;
