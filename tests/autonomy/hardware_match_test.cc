@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -21,11 +22,20 @@
 namespace slamo::autonomy {
 namespace {
 
-// The fake board in this process and the host's link to it, on one simulated clock.
+// The fake board in this process and the host's link to it, on one simulated clock. The host
+// opens the board through a symlink of this process's own: a replugged pty gets whichever
+// /dev/pts number is free, and with tests running in parallel (ctest -j) the old number can
+// go to another process's pty, which the host would then open instead (seen once in CI:
+// no reconnection).
 struct Bench {
   explicit Bench(const field::RobotConfig& robot, const platform::FakeBoardOptions& options = {})
-      : board(robot.drive, options),
+      : board(robot.drive, options, LinkPath()),
         link(platform::MakeMrptSerialTransport(board.device_path()), clock, LinkOptions(robot)) {}
+  static std::string LinkPath() {
+    static int count = 0;
+    return ::testing::TempDir() + "/slamo_hardware_match_" + std::to_string(::getpid()) + "_" +
+           std::to_string(count++);
+  }
   static platform::SerialDriveOptions LinkOptions(const field::RobotConfig& robot) {
     platform::SerialDriveOptions o;
     o.pid = robot.drive.pid;
