@@ -20,8 +20,8 @@ using strategy::ActionKind;
 // Tracked objects against where the objects really are at the end.
 std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
   std::vector<ObjectReport> out;
-  for (const mapping::TrackedObject& o : world.tracker().objects()) {
-    if (!world.tracker().Confirmed(o)) continue;
+  for (const mapping::TrackedObject& o : world.slam().tracker().objects()) {
+    if (!world.slam().tracker().Confirmed(o)) continue;
     ObjectReport r;
     r.id = o.id;
     r.kind = o.kind;
@@ -225,12 +225,12 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
   result.paths = world.paths();
   result.landmark_truth = world.landmark_truth();
   result.board = world.io().Status();
-  for (int i = 0; i < world.ekf().landmark_count(); ++i) {
-    result.landmark_estimates.push_back(world.ekf().landmark(i));
-    result.landmark_covariances.push_back(world.ekf().landmark_covariance(i));
+  for (int i = 0; i < world.slam().ekf().landmark_count(); ++i) {
+    result.landmark_estimates.push_back(world.slam().ekf().landmark(i));
+    result.landmark_covariances.push_back(world.slam().ekf().landmark_covariance(i));
   }
   result.field = world.field();
-  if (!out_dir.empty()) world.object_map().WriteBinary(out_dir + "/objects.bt");
+  if (!out_dir.empty()) world.slam().object_map().WriteBinary(out_dir + "/objects.bt");
   result.wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;

@@ -18,12 +18,6 @@ using platform::Pose2D;
 
 constexpr double kPi = 3.14159265358979323846;
 
-mapping::OdometryStep Increment(const Pose2D& from, const Pose2D& to) {
-  const double c = std::cos(from.theta_rad), s = std::sin(from.theta_rad);
-  const double dx = to.x_m - from.x_m, dy = to.y_m - from.y_m;
-  return {c * dx + s * dy, -s * dx + c * dy, platform::WrapAngleRad(to.theta_rad - from.theta_rad)};
-}
-
 DriveStep Turn(double degrees) {
   return {DriveStepKind::kTurn, degrees, "turn " + std::to_string(degrees)};
 }
@@ -50,10 +44,6 @@ constexpr double kMinSpeed_mps = 0.06;
 
 // How far the robot backs off a goal after a release.
 constexpr double kBackOff_m = 0.15;
-
-// A per-frame measurement bias shared by a stop's frames (range m, bearing rad), so that
-// iterating frames does not shrink the covariance below what the camera's bias allows.
-const Eigen::Matrix2d kStopBias = Eigen::Vector2d(0.01 * 0.01, 0.005 * 0.005).asDiagonal();
 
 // The robot as driven in a match: at its match speed (or `speed_mps`), turning in place at
 // that wheel speed, which is what the drive controller does.
@@ -86,14 +76,17 @@ std::vector<int> MarkerIds(const field::SeasonConfig& field) {
   return marker_id;
 }
 
-std::vector<int> AddSurveyedMarkers(const field::SeasonConfig& field, mapping::EkfSlam* ekf) {
-  const std::vector<Eigen::Vector2d> markers = SurveyedMarkers(field);
-  const std::vector<int> marker_id = MarkerIds(field);
-  for (size_t i = 0; i < field.landmarks.size(); ++i) {
-    ekf->AddKnownLandmark(markers[i], Eigen::Matrix2d::Identity() * 1e-6, marker_id[i],
-                          field.landmarks[i].colour);
-  }
-  return marker_id;
+mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
+                            const platform::Pose2D& start, bool relocalise) {
+  mapping::SlamOPrior prior;
+  prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
+  prior.covariance = Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal();
+  prior.surveyed_markers = SurveyedMarkers(field);
+  prior.marker_sigma_m = 1e-3;
+  mapping::SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  options.relocalise = relocalise;
+  return mapping::SlamO(field, robot.camera, prior, options);
 }
 
 platform::Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance,
@@ -145,22 +138,12 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
       perceive_(perceive),
       deadline_s_(season.rules.autonomous_s),
       io_(std::move(io)),
-      ekf_(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-6),
-      object_map_(field_),
-      obstacle_map_(field_),
+      slam_(
+          SurveyedSlam(field_, robot_, StartPose(field_, setup.alliance, setup.start_index), true)),
       travel_(robot_.drive) {
   const Pose2D start_pose = StartPose(field_, setup.alliance, setup.start_index);
   io_->Start(field_, robot_, start_pose);
   markers_ = SurveyedMarkers(field_);
-  landmark_detector_ = vision::LandmarkDetectorSetup(field_, &robot_.camera);
-  object_detector_ = vision::ObjectDetectorSetup(field_, &robot_.camera);
-  // The starting tile is known to a centimetre and a degree.
-  mapping::EkfOptions ekf_options;
-  ekf_options.add_landmarks = false;  // the surveyed markers are all there is
-  ekf_ = mapping::EkfSlam(Eigen::Vector3d(start_pose.x_m, start_pose.y_m, start_pose.theta_rad),
-                          Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal(),
-                          ekf_options);
-  marker_id_ = AddSurveyedMarkers(field_, &ekf_);
   // The preload: loaded by hand, so its kind and colour are known.
   if (const std::optional<IntakeItem> preload = io_->Preload()) {
     strategy::ObjectBelief held;
@@ -193,7 +176,7 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
   planner_options.stop_spacing_m = 0.0;
   planner_ = std::make_unique<planning::Planner>(robot_, planner_options);
   planning::SeedPlanners(seed);
-  planner_->SetMap(obstacle_map_);
+  planner_->SetMap(slam_.obstacle_map());
   travel_.SetPlanner(*planner_);
 
   context_.season = &field_;
@@ -212,14 +195,11 @@ strategy::Belief MatchWorld::Belief() const {
   strategy::Belief b;
   b.now_s = now_s();
   b.deadline_s = deadline_s_;
-  b.pose = ekf_.pose();
-  b.pose_covariance = ekf_.pose_covariance();
+  b.pose = slam_.pose();
+  b.pose_covariance = slam_.pose_covariance();
   b.held = held_;
-  for (const mapping::TrackedObject& o : tracker_.objects()) {
-    if (!tracker_.Confirmed(o)) continue;
-    if (std::find(picked_ids_.begin(), picked_ids_.end(), o.id) != picked_ids_.end()) continue;
+  for (const mapping::TrackedObject& o : slam_.ConfirmedObjects(picked_ids_))
     b.objects.push_back({o.id, o.kind, o.colour, o.position_m, o.covariance, o.confidence});
-  }
   return b;
 }
 
@@ -238,7 +218,7 @@ void MatchWorld::Advance(double dt_s) {
 }
 
 void MatchWorld::RecordSample() {
-  PoseSample sample{now_s(), Eigen::Vector3d::Zero(), ekf_.pose(), ekf_.pose_covariance(), false};
+  PoseSample sample{now_s(), Eigen::Vector3d::Zero(), slam_.pose(), slam_.pose_covariance(), false};
   if (const std::optional<Pose2D> t = io_->TruePose()) {
     sample.truth_known = true;
     sample.truth = Eigen::Vector3d(t->x_m, t->y_m, t->theta_rad);
@@ -256,11 +236,11 @@ void MatchWorld::MaybeSnapshot(bool force) {
   s.truth_known = truth.has_value();
   if (truth) s.truth = *truth;
   // Between filter updates the estimate is the last one moved by the encoders since.
-  mapping::OdometryStep u = Increment(odometry_, io_->OdometryPose());
+  mapping::OdometryStep u = mapping::OdometryIncrement(odometry_, io_->OdometryPose());
   u.dx_m *= odometry_scale_;
   u.dy_m *= odometry_scale_;
-  s.estimate = mapping::EkfSlam::Move(ekf_.pose(), u, nullptr, nullptr);
-  s.covariance = ekf_.pose_covariance();
+  s.estimate = mapping::EkfSlam::Move(slam_.pose(), u, nullptr, nullptr);
+  s.covariance = slam_.pose_covariance();
   if (const platform::SimField* sim = io_->sim()) {
     for (const platform::SimObject& o : sim->world().objects) {
       if (o.held) continue;
@@ -282,7 +262,7 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   const std::vector<platform::DriveStepResult> results =
       platform::RunDriveScript(steps, drive_options_, body);
   const Pose2D now = io_->OdometryPose();
-  mapping::OdometryStep u = Increment(odometry_, now);
+  mapping::OdometryStep u = mapping::OdometryIncrement(odometry_, now);
   u.dx_m *= odometry_scale_;
   u.dy_m *= odometry_scale_;
   if (setup_.gyro) {
@@ -293,7 +273,7 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
     u.dtheta_rad = platform::WrapAngleRad(heading - gyro_heading_);
     gyro_heading_ = heading;
   }
-  ekf_.Predict(u);
+  slam_.Predict(u);
   odometry_ = now;
   RecordSample();
   return std::all_of(results.begin(), results.end(), [](const platform::DriveStepResult& r) {
@@ -310,160 +290,58 @@ int MatchWorld::Observe(int max_frames) {
   rule.fixed_frames = std::min(rule.fixed_frames, max_frames);
   rule.gmm_max_frames = std::min(rule.gmm_max_frames, max_frames);
   rule.gmm_min_frames = std::min(rule.gmm_min_frames, max_frames);
-  mapping::FrameSelector selector(rule);
-  selector.Start(ekf_.pose_covariance());
+  slam_.BeginStop(rule);
   platform::RgbdFrame rgbd;
   int taken = 0;
   bool last_tracked = false;
-  bool relocalised = false;
   int missed_frames = 0;
   const double dt = 1.0 / robot_.camera.frame_rate_hz;
-  for (int frame = 1; now_s() < deadline_s_; ++frame) {
+  while (now_s() < deadline_s_) {
     std::optional<platform::RgbdFrame> captured = io_->Capture();
     if (!captured) {
       // No frame from the camera (RobotIo::Capture waited for one): try again a frame period
       // later, and give up the look after three misses in a row.
       if (++missed_frames >= 3) break;
-      --frame;
       Advance(dt);
       continue;
     }
     missed_frames = 0;
     rgbd = std::move(*captured);
-    std::vector<mapping::RangeBearing> measurements;
-    for (const vision::Detection& d :
-         vision::Detect(rgbd.colour, rgbd.depth_mm, landmark_detector_, {})) {
-      if (!d.measurement) continue;
-      int index = -1;
-      for (size_t i = 0; i < field_.landmarks.size(); ++i) {
-        if (field_.landmarks[i].colour == d.colour) index = static_cast<int>(i);
-      }
-      if (index < 0) continue;
-      mapping::RangeBearing z;
-      z.range_m = d.measurement->range_m;
-      z.bearing_rad = d.measurement->bearing_rad;
-      z.covariance = mapping::IteratedFrameCovariance(d.measurement->covariance, kStopBias, frame);
-      z.id = marker_id_[index];
-      z.signature = d.colour;
-      measurements.push_back(z);
-    }
-    // A frame whose update would throw the pose off the field or jump it further than the
-    // belief allows (3 sigma, at least 0.3 m) paired wrongly: it is dropped.
-    const auto plausible = [&](const mapping::EkfSlam& prior) {
-      const Eigen::Vector2d jump = ekf_.pose().head<2>() - prior.pose().head<2>();
-      const double allowed =
-          std::max(0.3, 3.0 * std::sqrt(prior.pose_covariance().topLeftCorner<2, 2>().trace()));
-      const double half = field_.HalfSize();
-      return jump.norm() <= allowed && std::abs(ekf_.pose().x()) < half &&
-             std::abs(ekf_.pose().y()) < half;
-    };
-    const mapping::EkfSlam prior = ekf_;
-    std::vector<mapping::UpdateOutcome> outcomes = ekf_.UpdateFrame(measurements);
-    if (!plausible(prior)) {
-      ekf_ = prior;
-      outcomes.assign(measurements.size(), mapping::UpdateOutcome::kRejected);
-      ++rejected_frames_;
-    }
-    const bool paired = std::any_of(outcomes.begin(), outcomes.end(), [](mapping::UpdateOutcome o) {
-      return o == mapping::UpdateOutcome::kUpdated;
-    });
-    if (!paired && !measurements.empty() && !relocalised) {
-      // Markers in view and none fits: the estimate has left the truth (the wheels spun while
-      // the robot pushed something it could not move; the encoders cannot tell). Widen the
-      // pose belief and pair again: first a little, needing one marker; then more, needing
-      // two (the markers' colours repeat point-symmetrically, so a single pairing under a
-      // wide belief could be the twin). A result off the field or beyond the widened belief
-      // is dropped.
-      relocalised = true;
-      const mapping::EkfSlam before = ekf_;
-      const struct {
-        double sigma_m, sigma_deg;
-        long needed;
-      } steps[] = {{0.2, 40.0, 1}, {0.6, 60.0, 2}};
-      for (const auto& step : steps) {
-        ekf_.InflatePoseCovariance(Eigen::Vector3d(step.sigma_m * step.sigma_m,
-                                                   step.sigma_m * step.sigma_m,
-                                                   std::pow(step.sigma_deg * kPi / 180.0, 2))
-                                       .asDiagonal());
-        const mapping::EkfSlam widened = ekf_;
-        const std::vector<mapping::UpdateOutcome> retry = ekf_.UpdateFrame(measurements);
-        const auto updated =
-            std::count(retry.begin(), retry.end(), mapping::UpdateOutcome::kUpdated);
-        if (updated >= step.needed && plausible(widened)) {
-          ++relocalisations_;
-          break;
-        }
-        ekf_ = widened;
-        if (&step == &steps[1]) ekf_ = before;
-      }
-    }
+    const mapping::LandmarkFrame update = slam_.UpdateLandmarks(rgbd);
     // Objects on the first frame and the last: two sightings confirm an object, so a single
     // stop can map what it sees; a false detection rarely survives both.
-    if (frame == 1) TrackObjects(rgbd);
-    last_tracked = frame == 1;
+    if (taken == 0) slam_.TrackObjects(rgbd, now_s());
+    last_tracked = taken == 0;
     ++taken;
     ++frames_;
     Advance(dt);
     RecordSample();
     MaybeSnapshot();
-    if (!selector.Continue(ekf_.pose(), ekf_.pose_covariance())) break;
+    if (!update.more_frames) break;
   }
   if (taken == 0) return 0;
-  if (!last_tracked) TrackObjects(rgbd);
+  if (!last_tracked) slam_.TrackObjects(rgbd, now_s());
   UpdateMaps();
   return taken;
-}
-
-void MatchWorld::TrackObjects(const platform::RgbdFrame& rgbd) {
-  std::vector<mapping::ObjectObservation> seen;
-  for (const vision::Detection& d :
-       vision::Detect(rgbd.colour, rgbd.depth_mm, object_detector_, {})) {
-    if (!d.measurement) continue;
-    seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
-                    d.measurement->covariance});
-  }
-  // Placed through the best pose estimate (and its covariance).
-  const Eigen::Vector3d pose = ekf_.pose();
-  const double half_fov = std::atan(robot_.camera.width_px / 2.0 / robot_.camera.fx) - 0.05;
-  tracker_.Update(pose, ekf_.pose_covariance(), seen, now_s(), [&](const Eigen::Vector2d& p) {
-    const Eigen::Vector2d z = mapping::EkfSlam::Observe(pose, p);
-    return z.x() > 0.8 && z.x() < 3.5 && std::abs(z.y()) < half_fov;
-  });
 }
 
 void MatchWorld::UpdateMaps() {
   // Objects narrower than half the robot are pushed aside by it (the simulator's contact
   // rule; VEX robots sweep small balls): they are mapped but not planned around. Larger ones
-  // are obstacles: pushed, they pin against others and stop the robot.
-  std::vector<mapping::MappedObject> all, obstacles;
-  for (const strategy::ObjectBelief& o : Belief().objects) {
-    const field::ObjectType* type = field_.FindObjectType(o.kind);
-    if (!type) continue;
-    const mapping::MappedObject m{
-        o.id,
-        o.kind,
-        o.colour,
-        Eigen::Vector3d(o.position_m.x(), o.position_m.y(), type->height_m / 2.0),
-        type->size_m / 2.0,
-        type->height_m,
-        o.confidence};
-    all.push_back(m);
-    if (type->size_m < setup_.pushable_fraction * robot_.width_m) continue;
-    // An obstacle without the clearance margin: grazing a ball only nudges it, and the full
-    // margin would close the approaches to the goals the balls lie around.
-    mapping::MappedObject obstacle = m;
-    obstacle.radius_m =
-        std::max(0.02, m.radius_m - planner_->inflation_radius_m() + robot_.width_m / 2.0);
-    obstacles.push_back(obstacle);
-  }
-  object_map_.SetObjects(all);
-  obstacle_map_.SetObjects(obstacles);
-  planner_->SetMap(obstacle_map_);
+  // are obstacles: pushed, they pin against others and stop the robot. An obstacle has no
+  // clearance margin: grazing a ball only nudges it, and the full margin would close the
+  // approaches to the goals the balls lie around.
+  mapping::ObstacleRule obstacles;
+  obstacles.min_size_m = setup_.pushable_fraction * robot_.width_m;
+  obstacles.shrink_m = planner_->inflation_radius_m();
+  obstacles.grow_m = robot_.width_m / 2.0;
+  slam_.UpdateMaps(picked_ids_, obstacles);
+  planner_->SetMap(slam_.obstacle_map());
   travel_.SetPlanner(*planner_);
 }
 
 bool MatchWorld::TurnTo(double heading_rad) {
-  const double turn = platform::WrapAngleRad(heading_rad - ekf_.pose().z());
+  const double turn = platform::WrapAngleRad(heading_rad - slam_.pose().z());
   if (std::abs(turn) < 2.0 * kPi / 180.0) return true;
   return Drive({Turn(turn * 180.0 / kPi)});
 }
@@ -490,7 +368,7 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
   const double give_up_s = budget_s > 0.0 ? now_s() + budget_s : deadline_s_;
   const auto out_of_time = [&]() { return now_s() >= std::min(give_up_s, deadline_s_); };
   for (int attempt = 0; attempt < 3 && !out_of_time(); ++attempt) {
-    Eigen::Vector3d pose = ekf_.pose();
+    Eigen::Vector3d pose = slam_.pose();
     if (!planner_->IsClear(pose.head<2>())) {
       // After a close approach the robot stands inside the clearance margin: back out, along
       // its heading, to the nearest clear point behind it (or turn away first if there is none).
@@ -507,7 +385,7 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
       } else {
         Drive({Turn(180.0), Forward(0.3 / odometry_scale_)});
       }
-      pose = ekf_.pose();
+      pose = slam_.pose();
     }
     planning::PlanRequest request;
     request.start_x_m = pose.x();
@@ -556,7 +434,7 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
     for (size_t i = 0; i < waypoints.size() && !replan; ++i) {
       if (out_of_time()) return false;
       // Each segment is aimed from the latest estimate: SLAM-O corrects the encoders' drift.
-      Eigen::Vector3d est = ekf_.pose();
+      Eigen::Vector3d est = slam_.pose();
       Eigen::Vector2d d = waypoints[i] - est.head<2>();
       if (d.norm() < 0.02) continue;
       const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
@@ -576,7 +454,7 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
           replan = true, ++replans_;
           break;
         }
-        est = ekf_.pose();
+        est = slam_.pose();
         d = waypoints[i] - est.head<2>();
         const double again = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
         std::vector<DriveStep> steps;
@@ -591,9 +469,9 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
     // Arrival, closed on SLAM-O: observe, and drive the rest while the estimate is off.
     for (int fix = 0; perceive_ && fix < setup_.arrival_fixes && !out_of_time(); ++fix) {
       Observe(std::max(frames_per_stop, setup_.correction_frames));
-      const Eigen::Vector2d d = target.head<2>() - ekf_.pose().head<2>();
+      const Eigen::Vector2d d = target.head<2>() - slam_.pose().head<2>();
       if (d.norm() < setup_.arrival_tolerance_m) break;
-      const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - ekf_.pose().z());
+      const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - slam_.pose().z());
       if (std::abs(turn) > kPi / 2) {  // overshot: back up rather than turn round
         Drive({Turn(platform::WrapAngleRad(turn + kPi) * 180.0 / kPi),
                Forward(-d.norm() / odometry_scale_)});
@@ -602,7 +480,7 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
       }
     }
     TurnTo(target.z());
-    return (ekf_.pose().head<2>() - target.head<2>()).norm() < 0.12;
+    return (slam_.pose().head<2>() - target.head<2>()).norm() < 0.12;
   }
   return false;
 }
@@ -622,7 +500,7 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   }
   const double r =
       ObjectRadius(target.kind.empty() ? field_.object_types.front().name : target.kind);
-  const Eigen::Vector3d est = ekf_.pose();
+  const Eigen::Vector3d est = slam_.pose();
   const Eigen::Vector2d d = target.position_m - est.head<2>();
   const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
   const double forward = d.norm() - strategy::PickDistance(robot_, r);
@@ -655,7 +533,7 @@ bool MatchWorld::Score(const strategy::Action& action) {
   Observe(setup_.correction_frames);
   const Eigen::Vector2d drop =
       strategy::DropTarget(field_, robot_, action.goal_index, action.target, r, margin);
-  const Eigen::Vector3d est = ekf_.pose();
+  const Eigen::Vector3d est = slam_.pose();
   const Eigen::Vector2d d = drop - est.head<2>();
   const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
   const field::Goal& goal = field_.goals[action.goal_index];

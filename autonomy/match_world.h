@@ -19,17 +19,14 @@
 #include "autonomy/robot_io.h"
 #include "field_configs/robot_config.h"
 #include "field_configs/season_config.h"
-#include "mapping/ekf_slam.h"
 #include "mapping/frame_selection.h"
-#include "mapping/object_map.h"
-#include "mapping/object_tracker.h"
+#include "mapping/slam_o.h"
 #include "planning/planner.h"
 #include "platform/clock.h"
 #include "platform/drive_script.h"
 #include "platform/sim_field.h"
 #include "strategy/strategy.h"
 #include "strategy/travel_field.h"
-#include "vision/detector.h"
 
 namespace slamo::autonomy {
 
@@ -135,9 +132,8 @@ class MatchWorld {
   const platform::SimField* sim() const { return io_->sim(); }
   RobotIo& io() { return *io_; }
   const RobotIo& io() const { return *io_; }
-  const mapping::EkfSlam& ekf() const { return ekf_; }
-  const mapping::ObjectTracker& tracker() const { return tracker_; }
-  const mapping::ObjectMap& object_map() const { return object_map_; }
+  // SLAM-O: the EKF, the object tracker and the maps.
+  const mapping::SlamO& slam() const { return slam_; }
   const std::vector<PoseSample>& samples() const { return samples_; }
   const std::vector<Snapshot>& snapshots() const { return snapshots_; }
   const std::vector<std::vector<Eigen::Vector2d>>& paths() const { return paths_; }
@@ -146,8 +142,8 @@ class MatchWorld {
   double overrun_s() const { return overrun_s_; }
   int frames() const { return frames_; }
   int replans() const { return replans_; }
-  int relocalisations() const { return relocalisations_; }
-  int rejected_frames() const { return rejected_frames_; }
+  int relocalisations() const { return slam_.relocalisations(); }
+  int rejected_frames() const { return slam_.gated_frames(); }
   double odometry_scale() const { return odometry_scale_; }
   double last_motion_s() const { return last_motion_s_; }
   void set_action_label(const std::string& label) { action_label_ = label; }
@@ -159,7 +155,6 @@ class MatchWorld {
   void RecordSample();
   void MaybeSnapshot(bool force = false);
   void UpdateMaps();
-  void TrackObjects(const platform::RgbdFrame& rgbd);
   void Init(uint64_t seed);
   bool PathClear(const std::vector<Eigen::Vector2d>& path) const;
   double ObjectRadius(const std::string& kind) const;
@@ -170,14 +165,8 @@ class MatchWorld {
   bool perceive_;
   double deadline_s_;
   std::unique_ptr<RobotIo> io_;
+  mapping::SlamO slam_;  // the EKF, the object tracker, the object and obstacle maps
   std::vector<Eigen::Vector2d> markers_;
-  vision::DetectorSetup landmark_detector_;
-  vision::DetectorSetup object_detector_;
-  std::vector<int> marker_id_;
-  mapping::EkfSlam ekf_;
-  mapping::ObjectTracker tracker_;
-  mapping::ObjectMap object_map_;    // every confirmed object: the map SLAM-O keeps
-  mapping::ObjectMap obstacle_map_;  // what the planner avoids (pushable objects left out)
   std::unique_ptr<planning::Planner> planner_;
   double gyro_heading_ = 0.0;  // the gyro's reading at the last prediction
   strategy::TravelField travel_;
@@ -196,8 +185,6 @@ class MatchWorld {
   double last_motion_s_ = 0.0;
   int frames_ = 0;
   int replans_ = 0;
-  int relocalisations_ = 0;
-  int rejected_frames_ = 0;
 };
 
 // The surveyed perimeter markers' centres: where the renderer draws them (a plate's centre
@@ -206,9 +193,11 @@ std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field);
 // Each marker's id in the filter: its index when no other marker shares its colour, else -1
 // (associated by position).
 std::vector<int> MarkerIds(const field::SeasonConfig& field);
-// The markers into `ekf` as known landmarks; a colour shared by several is associated by
-// position (JCBB). Returns each marker's id in the filter (-1: associated by position).
-std::vector<int> AddSurveyedMarkers(const field::SeasonConfig& field, mapping::EkfSlam* ekf);
+// SLAM-O as a match runs it: from `start`, known to a centimetre and a degree, over the
+// season's surveyed markers, known to a millimetre and all there is (no new landmarks); with
+// `relocalise`, a belief that left the truth is widened and paired again.
+mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
+                            const platform::Pose2D& start, bool relocalise);
 
 // The pose of the alliance's start_index-th starting tile (throws std::invalid_argument when
 // there is none).

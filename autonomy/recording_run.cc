@@ -9,11 +9,8 @@
 #include <stdexcept>
 
 #include "autonomy/match_world.h"
-#include "mapping/ekf_slam.h"
-#include "mapping/object_map.h"
-#include "mapping/object_tracker.h"
+#include "mapping/slam_o.h"
 #include "platform/recording.h"
-#include "vision/detector.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -21,15 +18,6 @@ namespace {
 using platform::Pose2D;
 
 constexpr double kPi = 3.14159265358979323846;
-
-// As in match_world.cc: the per-stop measurement bias (range m, bearing rad).
-const Eigen::Matrix2d kStopBias = Eigen::Vector2d(0.01 * 0.01, 0.005 * 0.005).asDiagonal();
-
-mapping::OdometryStep Increment(const Pose2D& from, const Pose2D& to) {
-  const double c = std::cos(from.theta_rad), s = std::sin(from.theta_rad);
-  const double dx = to.x_m - from.x_m, dy = to.y_m - from.y_m;
-  return {c * dx + s * dy, -s * dx + c * dy, platform::WrapAngleRad(to.theta_rad - from.theta_rad)};
-}
 
 // The ground truth at t_s, linear between the poses either side (held beyond the ends).
 Pose2D TruthAt(const std::vector<platform::StampedPose>& truth, double t_s) {
@@ -73,18 +61,10 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
   result.frames = "every frame of " + dir;
   result.field = season;
 
-  // The EKF at the first true pose (else the first red tile), over the surveyed markers.
+  // SLAM-O at the first true pose (else the first red tile), over the surveyed markers.
   const Pose2D start = has_truth ? truth.front().pose : FirstRedStart(season);
-  mapping::EkfOptions ekf_options;
-  ekf_options.add_landmarks = false;
-  mapping::EkfSlam ekf(Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad),
-                       Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal(),
-                       ekf_options);
-  const std::vector<int> marker_id = AddSurveyedMarkers(season, &ekf);
+  mapping::SlamO slam = SurveyedSlam(season, robot, start, /*relocalise=*/false);
   result.landmark_truth = SurveyedMarkers(season);
-  const vision::DetectorSetup landmark_detector =
-      vision::LandmarkDetectorSetup(season, &robot.camera);
-  const vision::DetectorSetup object_detector = vision::ObjectDetectorSetup(season, &robot.camera);
 
   // Wheel geometry: the recording's, else the robot file's.
   double metres_per_tick = reader->info().metres_per_tick;
@@ -98,10 +78,6 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
   size_t next_encoder = 1;
   Pose2D last_odometry;
 
-  mapping::ObjectTracker tracker;
-  mapping::ObjectMap object_map(season);
-  const double half_fov = std::atan(robot.camera.width_px / 2.0 / robot.camera.fx) - 0.05;
-  int frame_in_stop = 0;
   double t_first = 0.0, t_last = 0.0;
   TimelineEntry replay;
   int replay_updates = 0, replay_first = 0;
@@ -127,88 +103,41 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
       replay_first = frame;
     }
 
-    // Predict with the encoders' increment since the last frame.
+    // The encoders' increment since the last frame; objects on every N-th frame.
     mapping::OdometryStep u{0.0, 0.0, 0.0};
     if (odometry) {
       while (next_encoder < encoders.size() && encoders[next_encoder].t_s <= rgbd->t_s)
         odometry->Update(encoders[next_encoder++]);
-      u = Increment(last_odometry, odometry->pose());
+      u = mapping::OdometryIncrement(last_odometry, odometry->pose());
       last_odometry = odometry->pose();
     }
-    ekf.Predict(u);
-    // Frames of a standing robot share the camera's bias (IteratedFrameCovariance).
-    const bool still = std::hypot(u.dx_m, u.dy_m) < 1e-3 && std::abs(u.dtheta_rad) < 1e-3;
-    frame_in_stop = still ? frame_in_stop + 1 : 1;
-
-    std::vector<mapping::RangeBearing> measurements;
-    for (const vision::Detection& d :
-         vision::Detect(rgbd->colour, rgbd->depth_mm, landmark_detector, {})) {
-      if (!d.measurement) continue;
-      int index = -1;
-      for (size_t i = 0; i < season.landmarks.size(); ++i) {
-        if (season.landmarks[i].colour == d.colour) index = static_cast<int>(i);
-      }
-      if (index < 0) continue;
-      mapping::RangeBearing z;
-      z.range_m = d.measurement->range_m;
-      z.bearing_rad = d.measurement->bearing_rad;
-      z.covariance =
-          mapping::IteratedFrameCovariance(d.measurement->covariance, kStopBias, frame_in_stop);
-      z.id = marker_id[index];
-      z.signature = d.colour;
-      measurements.push_back(z);
-    }
-    // An update that jumps the pose beyond 3 sigma (at least 0.3 m) or off the field paired
-    // wrongly: the frame is dropped (as in MatchWorld::Observe).
-    const mapping::EkfSlam prior = ekf;
-    const std::vector<mapping::UpdateOutcome> outcomes = ekf.UpdateFrame(measurements);
-    const Eigen::Vector2d jump = ekf.pose().head<2>() - prior.pose().head<2>();
-    const double allowed =
-        std::max(0.3, 3.0 * std::sqrt(prior.pose_covariance().topLeftCorner<2, 2>().trace()));
-    if (jump.norm() > allowed || std::abs(ekf.pose().x()) >= season.HalfSize() ||
-        std::abs(ekf.pose().y()) >= season.HalfSize()) {
-      ekf = prior;
+    const bool objects =
+        options.object_every_n_frames > 0 && frame % options.object_every_n_frames == 0;
+    const mapping::LandmarkFrame update = slam.Process(*rgbd, u, objects);
+    if (update.gated) {
       ++result.rejected_frames;
     } else {
-      replay_updates += static_cast<int>(
-          std::count(outcomes.begin(), outcomes.end(), mapping::UpdateOutcome::kUpdated));
-    }
-
-    // Objects on every N-th frame, placed through the pose estimate.
-    if (options.object_every_n_frames > 0 && frame % options.object_every_n_frames == 0) {
-      std::vector<mapping::ObjectObservation> seen;
-      for (const vision::Detection& d :
-           vision::Detect(rgbd->colour, rgbd->depth_mm, object_detector, {})) {
-        if (!d.measurement) continue;
-        seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
-                        d.measurement->covariance});
-      }
-      const Eigen::Vector3d pose = ekf.pose();
-      tracker.Update(pose, ekf.pose_covariance(), seen, rgbd->t_s, [&](const Eigen::Vector2d& p) {
-        const Eigen::Vector2d z = mapping::EkfSlam::Observe(pose, p);
-        return z.x() > 0.8 && z.x() < 3.5 && std::abs(z.y()) < half_fov;
-      });
+      replay_updates += static_cast<int>(std::count(update.outcomes.begin(), update.outcomes.end(),
+                                                    mapping::UpdateOutcome::kUpdated));
     }
 
     const Pose2D t = has_truth ? TruthAt(truth, rgbd->t_s)
-                               : Pose2D{ekf.pose().x(), ekf.pose().y(), ekf.pose().z()};
+                               : Pose2D{slam.pose().x(), slam.pose().y(), slam.pose().z()};
     const Eigen::Vector3d truth_v(t.x_m, t.y_m, t.theta_rad);
-    result.samples.push_back({rgbd->t_s, truth_v, ekf.pose(), ekf.pose_covariance(), has_truth});
+    result.samples.push_back({rgbd->t_s, truth_v, slam.pose(), slam.pose_covariance(), has_truth});
     Snapshot s;
     s.t_s = rgbd->t_s;
     s.truth_known = has_truth;
     s.truth = t;
-    s.estimate = ekf.pose();
-    s.covariance = ekf.pose_covariance();
+    s.estimate = slam.pose();
+    s.covariance = slam.pose_covariance();
     s.action = "REPLAY";
     result.snapshots.push_back(std::move(s));
   }
   if (result.frames_taken > 0) close_replay(result.frames_taken - 1);
 
   // The confirmed objects: the report and the object map (no truth to match them against).
-  std::vector<mapping::MappedObject> mapped;
-  for (const mapping::TrackedObject& o : tracker.objects()) {
-    if (!tracker.Confirmed(o)) continue;
+  for (const mapping::TrackedObject& o : slam.ConfirmedObjects()) {
     ObjectReport report;
     report.id = o.id;
     report.kind = o.kind;
@@ -216,14 +145,9 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
     report.estimate_m = o.position_m;
     report.covariance = o.covariance;
     result.objects.push_back(report);
-    const field::ObjectType* type = season.FindObjectType(o.kind);
-    if (!type) continue;
-    mapped.push_back({o.id, o.kind, o.colour,
-                      Eigen::Vector3d(o.position_m.x(), o.position_m.y(), type->height_m / 2.0),
-                      type->size_m / 2.0, type->height_m, o.confidence});
   }
-  object_map.SetObjects(mapped);
-  if (!out_dir.empty()) object_map.WriteBinary(out_dir + "/objects.bt");
+  slam.UpdateMaps();
+  if (!out_dir.empty()) slam.object_map().WriteBinary(out_dir + "/objects.bt");
 
   if (has_truth && !result.samples.empty()) {
     double sum_sq = 0.0;
@@ -233,9 +157,9 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
   } else {
     result.pose_ate_m = std::numeric_limits<double>::quiet_NaN();
   }
-  for (int i = 0; i < ekf.landmark_count(); ++i) {
-    result.landmark_estimates.push_back(ekf.landmark(i));
-    result.landmark_covariances.push_back(ekf.landmark_covariance(i));
+  for (int i = 0; i < slam.ekf().landmark_count(); ++i) {
+    result.landmark_estimates.push_back(slam.ekf().landmark(i));
+    result.landmark_covariances.push_back(slam.ekf().landmark_covariance(i));
   }
   result.deadline_s = t_last - t_first;
   result.duration_s = t_last - t_first;

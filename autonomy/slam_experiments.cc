@@ -7,26 +7,14 @@
 
 #include <Eigen/Geometry>
 
-#include "autonomy/match_world.h"
-#include "mapping/object_map.h"
+#include "mapping/slam_o.h"
 #include "platform/drive_script.h"
 #include "platform/sim_field.h"
 #include "platform/sim_renderer.h"
-#include "vision/detector.h"
 
 namespace slamo::autonomy {
-namespace {
 
 using platform::Pose2D;
-
-// The increment from one odometry pose to the next, in the frame of the first.
-mapping::OdometryStep Increment(const Pose2D& from, const Pose2D& to) {
-  const double c = std::cos(from.theta_rad), s = std::sin(from.theta_rad);
-  const double dx = to.x_m - from.x_m, dy = to.y_m - from.y_m;
-  return {c * dx + s * dy, -s * dx + c * dy, platform::WrapAngleRad(to.theta_rad - from.theta_rad)};
-}
-
-}  // namespace
 
 double WaypointsRun::AccumulatedError() const {
   double sum = 0.0;
@@ -76,23 +64,23 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
   WaypointsRun run;
   platform::SimField sim(field, robot, field::Alliance::kRed, seed, start);
   platform::SimRenderer renderer(field, robot.camera, platform::RenderOptions{}, seed);
-  const vision::DetectorSetup detector = vision::LandmarkDetectorSetup(field, &robot.camera);
-  const vision::DetectorSetup object_detector = vision::ObjectDetectorSetup(field, &robot.camera);
-  mapping::EkfSlam ekf(Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad),
-                       Eigen::Vector3d(1e-6, 1e-6, 1e-6).asDiagonal(), setup.ekf);
-  // A marker is identified by its colour only when no other marker shares it; otherwise the
-  // filter associates it by position.
-  const std::vector<int> marker_id = MarkerIds(field);
+  // SLAM-O as the thesis ran it: no plausibility gate, no relocalisation; the experiment's
+  // own measurement model.
+  mapping::SlamOOptions options;
+  options.ekf = setup.ekf;
+  options.stop_bias_covariance = setup.bias_covariance;
+  options.white_covariance = setup.white_covariance;
+  options.iterate_frames = setup.iterate;
+  options.plausibility_gate = false;
+  mapping::SlamOPrior prior;
+  prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
+  prior.covariance = Eigen::Vector3d(1e-6, 1e-6, 1e-6).asDiagonal();
   if (setup.known_landmarks) {
-    for (size_t i = 0; i < field.landmarks.size(); ++i) {
-      ekf.AddKnownLandmark(
-          renderer.landmark_centres()[i].head<2>(),
-          Eigen::Matrix2d::Identity() * setup.known_landmark_sigma_m * setup.known_landmark_sigma_m,
-          marker_id[i], field.landmarks[i].colour);
-    }
+    for (const Eigen::Vector3d& c : renderer.landmark_centres())
+      prior.surveyed_markers.push_back(c.head<2>());
+    prior.marker_sigma_m = setup.known_landmark_sigma_m;
   }
-  mapping::ObjectTracker tracker;
-  mapping::ObjectMap object_map(field);
+  mapping::SlamO slam(field, robot.camera, prior, options);
   std::map<int, double> first_range;
   const std::vector<platform::SimObject> initial_objects = sim.world().objects;
   platform::SimClock clock;
@@ -109,98 +97,60 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
     platform::RunDriveScript(platform::ParseDriveScript(leg), drive, &sim.drive(), &clock,
                              [&sim](double dt) { sim.Step(dt); });
     const Pose2D now = sim.drive().odometry_pose();
-    ekf.Predict(Increment(odometry, now));
+    slam.Predict(mapping::OdometryIncrement(odometry, now));
     odometry = now;
     const Pose2D truth = sim.robot_pose();
     const Eigen::Vector3d truth_v(truth.x_m, truth.y_m, truth.theta_rad);
 
     // Observe until the frame rule says stop.
-    mapping::FrameSelector selector(setup.frames);
-    selector.Start(ekf.pose_covariance());
+    slam.BeginStop(setup.frames);
     std::vector<Eigen::Vector2d> errors;
     platform::RgbdFrame rgbd;
-    for (int frame = 1;; ++frame) {
+    for (;;) {
       rgbd = renderer.Render(sim.world(), truth, clock.NowS(), nullptr);
       const auto t0 = std::chrono::steady_clock::now();
-      std::vector<mapping::RangeBearing> measurements;
-      for (const vision::Detection& d : vision::Detect(rgbd.colour, rgbd.depth_mm, detector, {})) {
-        if (!d.measurement) continue;
-        int index = -1;
-        for (size_t i = 0; i < field.landmarks.size(); ++i) {
-          if (field.landmarks[i].colour == d.colour) index = static_cast<int>(i);
-        }
-        if (index < 0) continue;
-        mapping::RangeBearing z;
-        z.range_m = d.measurement->range_m;
-        z.bearing_rad = d.measurement->bearing_rad;
-        const Eigen::Matrix2d white =
-            setup.white_covariance.isZero() ? d.measurement->covariance : setup.white_covariance;
-        z.covariance = mapping::IteratedFrameCovariance(white, setup.bias_covariance,
-                                                        setup.iterate ? frame : 1);
-        z.id = marker_id[index];
-        z.signature = d.colour;
-        measurements.push_back(z);
-        // The measurement's error against the truth (the marker as drawn), where the marker
-        // is known by its colour.
-        if (z.id >= 0) {
-          const Eigen::Vector2d expected =
-              mapping::EkfSlam::Observe(truth_v, renderer.landmark_centres()[z.id].head<2>());
-          errors.emplace_back(z.range_m - expected.x(),
-                              platform::WrapAngleRad(z.bearing_rad - expected.y()));
-        }
-      }
-      // One frame's markers together: JCBB pairs those not known by their colour.
-      ekf.UpdateFrame(measurements);
+      const mapping::LandmarkFrame update = slam.UpdateLandmarks(rgbd);
       run.compute_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      // Each measurement's error against the truth (the marker as drawn), where the marker is
+      // known by its colour.
+      for (const mapping::RangeBearing& z : update.measurements) {
+        if (z.id < 0) continue;
+        const Eigen::Vector2d expected =
+            mapping::EkfSlam::Observe(truth_v, renderer.landmark_centres()[z.id].head<2>());
+        errors.emplace_back(z.range_m - expected.x(),
+                            platform::WrapAngleRad(z.bearing_rad - expected.y()));
+      }
       ++run.frames;
       clock.Advance(1.0 / robot.camera.frame_rate_hz);
-      if (!setup.iterate || !selector.Continue(ekf.pose(), ekf.pose_covariance())) break;
+      if (!setup.iterate || !update.more_frames) break;
     }
     if (objects) {
-      // Objects once per stop, from the best pose estimate.
-      std::vector<mapping::ObjectObservation> seen;
-      for (const vision::Detection& d :
-           vision::Detect(rgbd.colour, rgbd.depth_mm, object_detector, {})) {
-        if (!d.measurement) continue;
-        seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
-                        d.measurement->covariance});
+      // Objects once per stop, from the best pose estimate; the confirmed ones go into the
+      // OctoMap (objects that vanished leave it).
+      slam.TrackObjects(rgbd, clock.NowS());
+      for (const mapping::TrackedObject& o : slam.tracker().objects()) {
+        if (!first_range.count(o.id))
+          first_range[o.id] = (o.position_m - slam.pose().head<2>()).norm();
       }
-      const Eigen::Vector3d pose = ekf.pose();
-      const double half_fov = std::atan(robot.camera.width_px / 2.0 / robot.camera.fx) - 0.05;
-      tracker.Update(pose, ekf.pose_covariance(), seen, clock.NowS(),
-                     [&](const Eigen::Vector2d& p) {
-                       const Eigen::Vector2d z = mapping::EkfSlam::Observe(pose, p);
-                       return z.x() > 0.8 && z.x() < 3.5 && std::abs(z.y()) < half_fov;
-                     });
-      // The confirmed objects go into the OctoMap (objects that vanished leave it).
-      std::vector<mapping::MappedObject> mapped;
-      for (const mapping::TrackedObject& o : tracker.objects()) {
-        if (!first_range.count(o.id)) first_range[o.id] = (o.position_m - pose.head<2>()).norm();
-        const field::ObjectType* type = field.FindObjectType(o.kind);
-        if (!tracker.Confirmed(o) || !type) continue;
-        mapped.push_back({o.id, o.kind, o.colour,
-                          Eigen::Vector3d(o.position_m.x(), o.position_m.y(), type->height_m / 2.0),
-                          type->size_m / 2.0, type->height_m, o.confidence});
-      }
-      object_map.SetObjects(mapped);
+      slam.UpdateMaps();
     }
     run.errors_by_stop.push_back(errors);
-    const Eigen::Vector3d estimate = ekf.pose();
+    const Eigen::Vector3d estimate = slam.pose();
     const Eigen::Vector2d odometry_in_field =
         field_from_odometry * Eigen::Vector2d(now.x_m, now.y_m);
     run.stop_error_m.push_back(std::hypot(estimate.x() - truth.x_m, estimate.y() - truth.y_m));
     run.odometry_error_m.push_back((odometry_in_field - truth_v.head<2>()).norm());
-    run.stop_nees.push_back(mapping::PoseNees(truth_v, estimate, ekf.pose_covariance()));
+    run.stop_nees.push_back(mapping::PoseNees(truth_v, estimate, slam.pose_covariance()));
   }
   if (objects && !setup.map_out_dir.empty()) {
-    object_map.WriteBinary(setup.map_out_dir + "/objects.bt");
-    object_map.WriteColored(setup.map_out_dir + "/objects.ot");
+    slam.object_map().WriteBinary(setup.map_out_dir + "/objects.bt");
+    slam.object_map().WriteColored(setup.map_out_dir + "/objects.ot");
   }
   // Score the tracked objects against where the objects really are now.
-  for (const mapping::TrackedObject& o : tracker.objects()) {
+  for (const mapping::TrackedObject& o : slam.tracker().objects()) {
     WaypointsRun::ObjectResult r;
     r.tracked = o;
-    r.confirmed = tracker.Confirmed(o);
+    r.confirmed = slam.tracker().Confirmed(o);
     r.first_range_m = first_range[o.id];
     double best = 0.5;
     for (size_t k = 0; k < sim.world().objects.size(); ++k) {

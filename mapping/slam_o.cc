@@ -1,0 +1,206 @@
+#include "mapping/slam_o.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace slamo::mapping {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+}  // namespace
+
+OdometryStep OdometryIncrement(const platform::Pose2D& from, const platform::Pose2D& to) {
+  const double c = std::cos(from.theta_rad), s = std::sin(from.theta_rad);
+  const double dx = to.x_m - from.x_m, dy = to.y_m - from.y_m;
+  return {c * dx + s * dy, -s * dx + c * dy, platform::WrapAngleRad(to.theta_rad - from.theta_rad)};
+}
+
+SlamO::SlamO(const field::SeasonConfig& season, const field::CameraConfig& camera,
+             const SlamOPrior& prior, const SlamOOptions& options)
+    : season_(season),
+      camera_(camera),
+      options_(options),
+      landmark_detector_(vision::LandmarkDetectorSetup(season_, &camera_)),
+      object_detector_(vision::ObjectDetectorSetup(season_, &camera_)),
+      ekf_(prior.pose, prior.covariance, options.ekf),
+      selector_(FrameSelectionOptions{}),
+      object_map_(season_),
+      obstacle_map_(season_) {
+  // A marker is identified by its colour only when no other marker shares it; otherwise the
+  // filter associates it by position.
+  const std::vector<field::Landmark>& landmarks = season_.landmarks;
+  marker_id_.assign(landmarks.size(), -1);
+  for (size_t i = 0; i < landmarks.size(); ++i) {
+    const auto same =
+        std::count_if(landmarks.begin(), landmarks.end(),
+                      [&](const field::Landmark& l) { return l.colour == landmarks[i].colour; });
+    if (same == 1) marker_id_[i] = static_cast<int>(i);
+  }
+  for (size_t i = 0; i < landmarks.size() && i < prior.surveyed_markers.size(); ++i) {
+    ekf_.AddKnownLandmark(prior.surveyed_markers[i],
+                          Eigen::Matrix2d::Identity() * prior.marker_sigma_m * prior.marker_sigma_m,
+                          marker_id_[i], landmarks[i].colour);
+  }
+}
+
+void SlamO::Predict(const OdometryStep& u) { ekf_.Predict(u); }
+
+void SlamO::BeginStop(const FrameSelectionOptions& rule) {
+  selector_ = FrameSelector(rule);
+  selector_.Start(ekf_.pose_covariance());
+  frame_in_stop_ = 0;
+  relocalised_in_stop_ = false;
+}
+
+std::vector<RangeBearing> SlamO::MarkerMeasurements(const platform::RgbdFrame& frame) const {
+  std::vector<RangeBearing> measurements;
+  for (const vision::Detection& d :
+       vision::Detect(frame.colour, frame.depth_mm, landmark_detector_, {})) {
+    if (!d.measurement) continue;
+    int index = -1;
+    for (size_t i = 0; i < season_.landmarks.size(); ++i) {
+      if (season_.landmarks[i].colour == d.colour) index = static_cast<int>(i);
+    }
+    if (index < 0) continue;
+    RangeBearing z;
+    z.range_m = d.measurement->range_m;
+    z.bearing_rad = d.measurement->bearing_rad;
+    const Eigen::Matrix2d white =
+        options_.white_covariance.isZero() ? d.measurement->covariance : options_.white_covariance;
+    z.covariance = IteratedFrameCovariance(white, options_.stop_bias_covariance,
+                                           options_.iterate_frames ? frame_in_stop_ : 1);
+    z.id = marker_id_[index];
+    z.signature = d.colour;
+    measurements.push_back(z);
+  }
+  return measurements;
+}
+
+bool SlamO::Plausible(const EkfSlam& prior) const {
+  const Eigen::Vector2d jump = ekf_.pose().head<2>() - prior.pose().head<2>();
+  const double allowed =
+      std::max(options_.gate_min_jump_m,
+               3.0 * std::sqrt(prior.pose_covariance().topLeftCorner<2, 2>().trace()));
+  const double half = season_.HalfSize();
+  return jump.norm() <= allowed && std::abs(ekf_.pose().x()) < half &&
+         std::abs(ekf_.pose().y()) < half;
+}
+
+bool SlamO::Relocalise(const std::vector<RangeBearing>& measurements) {
+  // Widen the pose belief and pair again: first a little, needing one marker; then more,
+  // needing two (the markers' colours repeat point-symmetrically, so a single pairing under a
+  // wide belief could be the twin). A result off the field or beyond the widened belief is
+  // dropped.
+  const EkfSlam before = ekf_;
+  const struct {
+    double sigma_m, sigma_deg;
+    long needed;
+  } steps[] = {{0.2, 40.0, 1}, {0.6, 60.0, 2}};
+  for (const auto& step : steps) {
+    ekf_.InflatePoseCovariance(Eigen::Vector3d(step.sigma_m * step.sigma_m,
+                                               step.sigma_m * step.sigma_m,
+                                               std::pow(step.sigma_deg * kPi / 180.0, 2))
+                                   .asDiagonal());
+    const EkfSlam widened = ekf_;
+    const std::vector<UpdateOutcome> retry = ekf_.UpdateFrame(measurements);
+    const auto updated = std::count(retry.begin(), retry.end(), UpdateOutcome::kUpdated);
+    if (updated >= step.needed && Plausible(widened)) {
+      ++relocalisations_;
+      return true;
+    }
+    ekf_ = widened;
+    if (&step == &steps[1]) ekf_ = before;
+  }
+  return false;
+}
+
+LandmarkFrame SlamO::UpdateLandmarks(const platform::RgbdFrame& frame) {
+  ++frame_in_stop_;
+  ++frames_;
+  LandmarkFrame out;
+  // Detect the markers; measure them with the covariance of the stop's frame_in_stop_-th frame.
+  out.measurements = MarkerMeasurements(frame);
+  // Update with the whole frame (JCBB pairs the markers not known by their colour), and gate.
+  const EkfSlam prior = ekf_;
+  out.outcomes = ekf_.UpdateFrame(out.measurements);
+  if (options_.plausibility_gate && !Plausible(prior)) {
+    ekf_ = prior;
+    out.outcomes.assign(out.measurements.size(), UpdateOutcome::kRejected);
+    out.gated = true;
+    ++gated_frames_;
+  }
+  // Markers in view and none fits: the estimate has left the truth.
+  const bool paired = std::any_of(out.outcomes.begin(), out.outcomes.end(),
+                                  [](UpdateOutcome o) { return o == UpdateOutcome::kUpdated; });
+  if (options_.relocalise && !paired && !out.measurements.empty() && !relocalised_in_stop_) {
+    relocalised_in_stop_ = true;
+    out.relocalised = Relocalise(out.measurements);
+  }
+  out.more_frames = selector_.Continue(ekf_.pose(), ekf_.pose_covariance());
+  return out;
+}
+
+void SlamO::TrackObjects(const platform::RgbdFrame& frame, double t_s) {
+  std::vector<ObjectObservation> seen;
+  for (const vision::Detection& d :
+       vision::Detect(frame.colour, frame.depth_mm, object_detector_, {})) {
+    if (!d.measurement) continue;
+    seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
+                    d.measurement->covariance});
+  }
+  // Placed through the best pose estimate (and its covariance); objects in view and range but
+  // not seen lose confidence.
+  const Eigen::Vector3d pose = ekf_.pose();
+  const double half_fov = std::atan(camera_.width_px / 2.0 / camera_.fx) - options_.fov_margin_rad;
+  tracker_.Update(pose, ekf_.pose_covariance(), seen, t_s, [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d z = EkfSlam::Observe(pose, p);
+    return z.x() > options_.object_min_range_m && z.x() < options_.object_max_range_m &&
+           std::abs(z.y()) < half_fov;
+  });
+}
+
+std::vector<TrackedObject> SlamO::ConfirmedObjects(const std::vector<int>& taken_ids) const {
+  std::vector<TrackedObject> out;
+  for (const TrackedObject& o : tracker_.objects()) {
+    if (!tracker_.Confirmed(o)) continue;
+    if (std::find(taken_ids.begin(), taken_ids.end(), o.id) != taken_ids.end()) continue;
+    out.push_back(o);
+  }
+  return out;
+}
+
+void SlamO::UpdateMaps(const std::vector<int>& taken_ids,
+                       const std::optional<ObstacleRule>& obstacles) {
+  std::vector<MappedObject> all, blocking;
+  for (const TrackedObject& o : ConfirmedObjects(taken_ids)) {
+    const field::ObjectType* type = season_.FindObjectType(o.kind);
+    if (!type) continue;
+    const MappedObject m{o.id,
+                         o.kind,
+                         o.colour,
+                         Eigen::Vector3d(o.position_m.x(), o.position_m.y(), type->height_m / 2.0),
+                         type->size_m / 2.0,
+                         type->height_m,
+                         o.confidence};
+    all.push_back(m);
+    if (!obstacles || type->size_m < obstacles->min_size_m) continue;
+    MappedObject obstacle = m;
+    obstacle.radius_m = std::max(0.02, m.radius_m - obstacles->shrink_m + obstacles->grow_m);
+    blocking.push_back(obstacle);
+  }
+  object_map_.SetObjects(all);
+  if (obstacles) obstacle_map_.SetObjects(blocking);
+}
+
+LandmarkFrame SlamO::Process(const platform::RgbdFrame& frame, const OdometryStep& u,
+                             bool track_objects) {
+  Predict(u);
+  const bool still = std::hypot(u.dx_m, u.dy_m) < 1e-3 && std::abs(u.dtheta_rad) < 1e-3;
+  if (!still) BeginStop();
+  LandmarkFrame out = UpdateLandmarks(frame);
+  if (track_objects) TrackObjects(frame, frame.t_s);
+  return out;
+}
+
+}  // namespace slamo::mapping

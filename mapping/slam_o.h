@@ -1,0 +1,159 @@
+// SLAM-O's front end, the thesis's pipeline in one place: a camera frame goes in, and what the
+// robot believes comes out. Read top to bottom, the public steps are the pipeline:
+//
+//   Predict       odometry since the last frame moves the EKF's pose
+//   BeginStop     the robot stands: the frame rule starts, and the stop's frames share a bias
+//   UpdateLandmarks  frame -> marker detections -> range-bearing measurements (iterated-frame
+//                 covariance) -> EKF update of the whole frame -> plausibility gate ->
+//                 relocalisation when markers are in view and none fits
+//   TrackObjects  frame -> object detections -> the object tracker, placed through the pose
+//   UpdateMaps    confirmed objects -> the OctoMap object map and the planner's obstacle map
+//
+// `Process` runs all of them for one frame, for callers with nothing to do between the steps
+// (a recording). The match loop, recording replay and the thesis experiments all go through
+// this class; none of them calls the detector or the EKF's updates itself.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "field_configs/robot_config.h"
+#include "field_configs/season_config.h"
+#include "mapping/ekf_slam.h"
+#include "mapping/frame_selection.h"
+#include "mapping/object_map.h"
+#include "mapping/object_tracker.h"
+#include "platform/drive_base.h"
+#include "platform/rgbd.h"
+#include "vision/detector.h"
+
+namespace slamo::mapping {
+
+struct SlamOOptions {
+  EkfOptions ekf;
+  // A per-stop measurement bias (range m^2, bearing rad^2) shared by a stop's frames, so that
+  // iterating frames does not shrink the covariance below what the camera's bias allows
+  // (IteratedFrameCovariance).
+  Eigen::Matrix2d stop_bias_covariance = Eigen::Vector2d(0.01 * 0.01, 0.005 * 0.005).asDiagonal();
+  // Per-frame (white) covariance of a marker measurement; zero: vision's own estimate for
+  // each detection.
+  Eigen::Matrix2d white_covariance = Eigen::Matrix2d::Zero();
+  bool iterate_frames = true;  // false: every frame weighs as the first of its stop
+  // Drop a frame whose update throws the pose off the field or further than the belief allows
+  // (3 sigma, at least gate_min_jump_m): it paired wrongly.
+  bool plausibility_gate = true;
+  double gate_min_jump_m = 0.3;
+  // Once per stop, when markers are in view and none pairs: widen the pose belief and pair
+  // again (the encoders cannot tell when the wheels spun against something that did not move).
+  bool relocalise = false;
+  // Objects are tracked, and expected to be seen, within this range and the camera's field of
+  // view less fov_margin_rad.
+  double object_min_range_m = 0.8;
+  double object_max_range_m = 3.5;
+  double fov_margin_rad = 0.05;
+};
+
+// Which mapped objects the planner avoids, and how large it takes them.
+struct ObstacleRule {
+  // Objects narrower than this are pushed aside by the robot: mapped, not planned round.
+  double min_size_m = 0.0;
+  // An obstacle's radius is its own less shrink_m plus grow_m (at least 2 cm): the planner's
+  // clearance margin taken off and half the robot's width put on.
+  double shrink_m = 0.0;
+  double grow_m = 0.0;
+};
+
+// What one frame did to the landmark part of the estimate.
+struct LandmarkFrame {
+  std::vector<RangeBearing> measurements;  // the frame's marker measurements, as used
+  std::vector<UpdateOutcome> outcomes;     // one per measurement (all kRejected when gated)
+  bool gated = false;                      // the plausibility gate dropped the frame
+  bool relocalised = false;                // a widened belief paired this frame
+  bool more_frames = false;                // the frame rule wants another frame at this stop
+};
+
+// Where the filter starts, and what it is told of the field.
+struct SlamOPrior {
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity() * 1e-6;
+  // The season's markers as known landmarks (their surveyed centres, one per season landmark
+  // in order), each known to marker_sigma_m; empty: the markers are found as the robot goes.
+  std::vector<Eigen::Vector2d> surveyed_markers;
+  double marker_sigma_m = 1e-3;
+};
+
+// The odometry increment from one dead-reckoned pose to the next, in the frame of the first.
+OdometryStep OdometryIncrement(const platform::Pose2D& from, const platform::Pose2D& to);
+
+class SlamO {
+ public:
+  // The filter starts from `prior`; markers and objects are detected with the season's
+  // colours through `camera`. A marker colour shared by several markers is associated by
+  // position (JCBB), a unique one by its colour.
+  SlamO(const field::SeasonConfig& season, const field::CameraConfig& camera,
+        const SlamOPrior& prior, const SlamOOptions& options = {});
+  // The object maps refer to the season kept here: neither copied nor moved.
+  SlamO(const SlamO&) = delete;
+  SlamO& operator=(const SlamO&) = delete;
+
+  // 1. Odometry since the last frame.
+  void Predict(const OdometryStep& u);
+  // 2. A stop begins: frames from here on are the stop's (the frame rule counts them).
+  void BeginStop(const FrameSelectionOptions& rule = {});
+  // 3. One frame's markers into the EKF.
+  LandmarkFrame UpdateLandmarks(const platform::RgbdFrame& frame);
+  // 4. One frame's objects into the tracker at t_s.
+  void TrackObjects(const platform::RgbdFrame& frame, double t_s);
+  // 5. The confirmed objects, less those taken off the field, into the object map and, by
+  // `obstacles` when given, the planner's obstacle map.
+  void UpdateMaps(const std::vector<int>& taken_ids = {},
+                  const std::optional<ObstacleRule>& obstacles = std::nullopt);
+
+  // Steps 1-4 for one frame: predict by `u`, a new stop when the robot moved (its frames
+  // then count from one again), the markers, and the objects when track_objects (at the
+  // frame's time). The maps are the caller's to update when it wants them.
+  LandmarkFrame Process(const platform::RgbdFrame& frame, const OdometryStep& u,
+                        bool track_objects);
+
+  // What it believes.
+  const EkfSlam& ekf() const { return ekf_; }
+  Eigen::Vector3d pose() const { return ekf_.pose(); }
+  Eigen::Matrix3d pose_covariance() const { return ekf_.pose_covariance(); }
+  const ObjectTracker& tracker() const { return tracker_; }
+  // Confirmed objects (seen often enough), less `taken_ids`, in the tracker's order.
+  std::vector<TrackedObject> ConfirmedObjects(const std::vector<int>& taken_ids = {}) const;
+  const ObjectMap& object_map() const { return object_map_; }
+  const ObjectMap& obstacle_map() const { return obstacle_map_; }
+  const FrameSelector& frame_selector() const { return selector_; }
+
+  // Counters over the run.
+  int frames() const { return frames_; }
+  int gated_frames() const { return gated_frames_; }
+  int relocalisations() const { return relocalisations_; }
+
+ private:
+  std::vector<RangeBearing> MarkerMeasurements(const platform::RgbdFrame& frame) const;
+  bool Plausible(const EkfSlam& prior) const;
+  bool Relocalise(const std::vector<RangeBearing>& measurements);
+
+  field::SeasonConfig season_;
+  field::CameraConfig camera_;
+  SlamOOptions options_;
+  vision::DetectorSetup landmark_detector_;
+  vision::DetectorSetup object_detector_;
+  std::vector<int> marker_id_;  // per season landmark: its id in the filter, -1: by position
+  EkfSlam ekf_;
+  FrameSelector selector_;
+  ObjectTracker tracker_;
+  ObjectMap object_map_;    // every confirmed object: the map SLAM-O keeps
+  ObjectMap obstacle_map_;  // what the planner avoids
+  int frame_in_stop_ = 0;
+  bool relocalised_in_stop_ = false;
+  int frames_ = 0;
+  int gated_frames_ = 0;
+  int relocalisations_ = 0;
+};
+
+}  // namespace slamo::mapping

@@ -1,0 +1,171 @@
+// SLAM-O's front end on frames rendered by the simulator, checked against the renderer's truth.
+#include "mapping/slam_o.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "field_configs/loader.h"
+#include "platform/sim_renderer.h"
+#include "platform/sim_world.h"
+
+namespace slamo::mapping {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+class SlamOTest : public ::testing::Test {
+ protected:
+  SlamOTest()
+      : season_(field::LoadSeasonConfig("toss_up")),
+        robot_(field::LoadRobotConfig(field::kDefaultRobot)),
+        world_(platform::CreateWorld(season_, 7)),
+        renderer_(season_, robot_.camera, platform::RenderOptions{}, 7) {}
+
+  // A start at `pose` with `covariance`, over the surveyed markers as the renderer draws them.
+  SlamOPrior Prior(const Eigen::Vector3d& pose, const Eigen::Matrix3d& covariance) const {
+    SlamOPrior prior;
+    prior.pose = pose;
+    prior.covariance = covariance;
+    for (const Eigen::Vector3d& c : renderer_.landmark_centres())
+      prior.surveyed_markers.push_back(c.head<2>());
+    return prior;
+  }
+  platform::RgbdFrame Render(const platform::Pose2D& pose, double t_s) {
+    return renderer_.Render(world_, pose, t_s, nullptr);
+  }
+  static Eigen::Vector3d V(const platform::Pose2D& p) {
+    return Eigen::Vector3d(p.x_m, p.y_m, p.theta_rad);
+  }
+  // Frames at `truth` until the frame rule stops; returns the frames taken.
+  int ObserveStop(SlamO* slam, const platform::Pose2D& truth, double t_s) {
+    slam->BeginStop();
+    for (int taken = 1; taken <= 30; ++taken) {
+      if (!slam->UpdateLandmarks(Render(truth, t_s + taken / 30.0)).more_frames) return taken;
+    }
+    return 30;
+  }
+
+  field::SeasonConfig season_;
+  field::RobotConfig robot_;
+  platform::SimWorld world_;
+  platform::SimRenderer renderer_;
+};
+
+// Mid field, facing the -x wall's markers.
+const platform::Pose2D kTruth{0.3, 0.2, kPi};
+
+TEST_F(SlamOTest, FramesOfMarkersPullAnOffsetPoseBackToTheTruth) {
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  const Eigen::Vector3d start = V(kTruth) + Eigen::Vector3d(0.06, -0.05, 0.03);
+  SlamO slam(season_, robot_.camera,
+             Prior(start, Eigen::Vector3d(0.08 * 0.08, 0.08 * 0.08, 0.05 * 0.05).asDiagonal()),
+             options);
+  const double before = (slam.pose() - V(kTruth)).head<2>().norm();
+  const int frames = ObserveStop(&slam, kTruth, 0.0);
+  const double after = (slam.pose() - V(kTruth)).head<2>().norm();
+  EXPECT_GT(before, 0.07);
+  EXPECT_LT(after, 0.03) << "after " << frames << " frames";
+  EXPECT_EQ(slam.frames(), frames);
+  EXPECT_EQ(slam.gated_frames(), 0);
+  // The belief shrank, and the truth lies inside it.
+  EXPECT_LT((slam.pose_covariance().topLeftCorner<2, 2>().trace()), 0.0064);
+  EXPECT_LT(PoseNees(V(kTruth), slam.pose(), slam.pose_covariance()), 16.3);  // chi2(3), 99.9 %
+}
+
+TEST_F(SlamOTest, AKidnappedRobotIsReacquiredOnlyWhenRelocalisationIsOn) {
+  // The filter believes the robot 0.5 m from where it is, and is sure of it.
+  const Eigen::Vector3d believed = V(kTruth) + Eigen::Vector3d(0.0, 0.5, 0.0);
+  const Eigen::Matrix3d sure = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
+  for (const bool relocalise : {false, true}) {
+    SlamOOptions options;
+    options.ekf.add_landmarks = false;
+    options.relocalise = relocalise;
+    SlamO slam(season_, robot_.camera, Prior(believed, sure), options);
+    ObserveStop(&slam, kTruth, 0.0);
+    ObserveStop(&slam, kTruth, 2.0);
+    const double error = (slam.pose() - V(kTruth)).head<2>().norm();
+    if (relocalise) {
+      EXPECT_GE(slam.relocalisations(), 1);
+      EXPECT_LT(error, 0.05);
+    } else {
+      EXPECT_EQ(slam.relocalisations(), 0);
+      EXPECT_GT(error, 0.3);
+    }
+  }
+}
+
+TEST_F(SlamOTest, FramesOfOneStopShareTheBiasAndAMoveStartsANewStop) {
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  options.white_covariance = Eigen::Vector2d(1e-4, 1e-5).asDiagonal();
+  options.stop_bias_covariance = Eigen::Vector2d(4e-4, 4e-5).asDiagonal();
+  SlamO slam(season_, robot_.camera, Prior(V(kTruth), Eigen::Matrix3d::Identity() * 1e-4), options);
+  const platform::RgbdFrame frame = Render(kTruth, 0.0);
+  const LandmarkFrame first = slam.Process(frame, {0.0, 0.0, 0.0}, false);
+  const LandmarkFrame second = slam.Process(frame, {0.0, 0.0, 0.0}, false);
+  const LandmarkFrame moved = slam.Process(frame, {0.01, 0.0, 0.0}, false);
+  ASSERT_FALSE(first.measurements.empty());
+  const Eigen::Matrix2d w = options.white_covariance, b = options.stop_bias_covariance;
+  EXPECT_TRUE(first.measurements[0].covariance.isApprox(IteratedFrameCovariance(w, b, 1)));
+  EXPECT_TRUE(second.measurements[0].covariance.isApprox(IteratedFrameCovariance(w, b, 2)));
+  EXPECT_TRUE(moved.measurements[0].covariance.isApprox(IteratedFrameCovariance(w, b, 1)));
+  // The second frame of a stop weighs less than the first.
+  EXPECT_GT(second.measurements[0].covariance(0, 0), first.measurements[0].covariance(0, 0));
+}
+
+TEST_F(SlamOTest, ObjectsSeenTwiceAreMappedWhereTheyAre) {
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  SlamO slam(season_, robot_.camera, Prior(V(kTruth), Eigen::Matrix3d::Identity() * 1e-6), options);
+  const platform::RgbdFrame frame = Render(kTruth, 0.0);
+  slam.TrackObjects(frame, 0.0);
+  EXPECT_TRUE(slam.ConfirmedObjects().empty());  // one sighting confirms nothing
+  slam.TrackObjects(Render(kTruth, 0.5), 0.5);
+  const std::vector<TrackedObject> confirmed = slam.ConfirmedObjects();
+  ASSERT_GE(confirmed.size(), 2u);
+  for (const TrackedObject& o : confirmed) {
+    double nearest = 1e9;
+    for (const platform::SimObject& t : world_.objects) {
+      if (t.colour == o.colour && t.type->name == o.kind)
+        nearest = std::min(nearest, (t.center_m.head<2>() - o.position_m).norm());
+    }
+    EXPECT_LT(nearest, 0.1) << o.kind << " " << o.colour;
+  }
+  // The maps: every confirmed object in the object map but the one taken off the field; the
+  // obstacle map only when asked, and only objects at least as wide as the rule's minimum.
+  const auto centre = [&](const TrackedObject& o) {
+    return Eigen::Vector3d(o.position_m.x(), o.position_m.y(),
+                           season_.FindObjectType(o.kind)->height_m / 2.0);
+  };
+  const int taken = confirmed.front().id;
+  ObstacleRule wide_only;
+  wide_only.min_size_m = 10.0;  // nothing is this wide: no obstacles
+  slam.UpdateMaps({taken}, wide_only);
+  EXPECT_FALSE(slam.object_map().IsOccupied(centre(confirmed.front())));
+  for (size_t k = 1; k < confirmed.size(); ++k) {
+    EXPECT_TRUE(slam.object_map().IsOccupied(centre(confirmed[k]))) << k;
+    EXPECT_FALSE(slam.obstacle_map().IsOccupied(centre(confirmed[k]))) << k;
+  }
+  slam.UpdateMaps({}, ObstacleRule{});
+  for (const TrackedObject& o : confirmed) EXPECT_TRUE(slam.obstacle_map().IsOccupied(centre(o)));
+  EXPECT_EQ(slam.ConfirmedObjects({taken}).size(), confirmed.size() - 1);
+}
+
+TEST(OdometryIncrementTest, IsTheMoveInTheFirstPosesFrame) {
+  const platform::Pose2D from{1.0, 2.0, kPi / 2};
+  const platform::Pose2D to{1.0, 3.0, kPi};
+  const OdometryStep u = OdometryIncrement(from, to);
+  EXPECT_NEAR(u.dx_m, 1.0, 1e-12);  // straight ahead of a robot facing +y
+  EXPECT_NEAR(u.dy_m, 0.0, 1e-12);
+  EXPECT_NEAR(u.dtheta_rad, kPi / 2, 1e-12);
+  // Moving `from` by the increment gives `to`.
+  const Eigen::Vector3d moved =
+      EkfSlam::Move(Eigen::Vector3d(from.x_m, from.y_m, from.theta_rad), u, nullptr, nullptr);
+  EXPECT_NEAR(moved.x(), to.x_m, 1e-12);
+  EXPECT_NEAR(moved.y(), to.y_m, 1e-12);
+}
+
+}  // namespace
+}  // namespace slamo::mapping
