@@ -6,8 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "platform/field_geometry.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -30,16 +29,6 @@ DriveStep Turn(double degrees) {
 DriveStep Forward(double metres) {
   return {DriveStepKind::kDrive, metres,
           (metres >= 0 ? "forward " : "back ") + std::to_string(std::abs(metres))};
-}
-
-const field::StartTile& StartFor(const field::SeasonConfig& season, field::Alliance alliance,
-                                 int index) {
-  int seen = 0;
-  for (const field::StartTile& s : season.starts) {
-    if (s.alliance == alliance && seen++ == index) return s;
-  }
-  throw std::invalid_argument(season.name + " has no starting tile " + std::to_string(index) +
-                              " for that alliance");
 }
 
 // Frames taken to check an arrival, and how close counts as arrived.
@@ -68,38 +57,14 @@ field::RobotConfig MatchRobot(const field::RobotConfig& robot, double speed_mps)
 
 }  // namespace
 
-std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field) {
-  std::vector<Eigen::Vector2d> out;
-  for (const field::Landmark& l : field.landmarks)
-    out.push_back(platform::LandmarkCentre(field, l).head<2>());
-  return out;
-}
-
-std::vector<int> MarkerIds(const field::SeasonConfig& field) {
-  std::vector<int> marker_id(field.landmarks.size(), -1);
-  for (size_t i = 0; i < field.landmarks.size(); ++i) {
-    const auto same = std::count_if(
-        field.landmarks.begin(), field.landmarks.end(),
-        [&](const field::Landmark& l) { return l.colour == field.landmarks[i].colour; });
-    if (same == 1) marker_id[i] = static_cast<int>(i);
-  }
-  return marker_id;
-}
-
 std::vector<int> AddSurveyedMarkers(const field::SeasonConfig& field, mapping::EkfSlam* ekf) {
-  const std::vector<Eigen::Vector2d> markers = SurveyedMarkers(field);
-  const std::vector<int> marker_id = MarkerIds(field);
+  const std::vector<Eigen::Vector2d> markers = platform::SurveyedMarkers(field);
+  const std::vector<int> marker_id = platform::MarkerIds(field);
   for (size_t i = 0; i < field.landmarks.size(); ++i) {
     ekf->AddKnownLandmark(markers[i], Eigen::Matrix2d::Identity() * 1e-6, marker_id[i],
                           field.landmarks[i].colour);
   }
   return marker_id;
-}
-
-platform::Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance,
-                           int start_index) {
-  const field::StartTile& start = StartFor(season, alliance, start_index);
-  return {start.center_m.x, start.center_m.y, start.heading_deg * kPi / 180.0};
 }
 
 field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m,
@@ -149,9 +114,9 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
       object_map_(field_),
       obstacle_map_(field_),
       travel_(robot_.drive) {
-  const Pose2D start_pose = StartPose(field_, setup.alliance, setup.start_index);
+  const Pose2D start_pose = platform::StartPose(field_, setup.alliance, setup.start_index);
   io_->Start(field_, robot_, start_pose);
-  markers_ = SurveyedMarkers(field_);
+  markers_ = platform::SurveyedMarkers(field_);
   landmark_detector_ = vision::LandmarkDetectorSetup(field_, &robot_.camera);
   object_detector_ = vision::ObjectDetectorSetup(field_, &robot_.camera);
   // The starting tile is known to a centimetre and a degree.

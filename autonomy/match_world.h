@@ -200,20 +200,9 @@ class MatchWorld {
   int rejected_frames_ = 0;
 };
 
-// The surveyed perimeter markers' centres: where the renderer draws them (a plate's centre
-// sits just off its wall), which is where a team's tape measure puts them.
-std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field);
-// Each marker's id in the filter: its index when no other marker shares its colour, else -1
-// (associated by position).
-std::vector<int> MarkerIds(const field::SeasonConfig& field);
 // The markers into `ekf` as known landmarks; a colour shared by several is associated by
 // position (JCBB). Returns each marker's id in the filter (-1: associated by position).
 std::vector<int> AddSurveyedMarkers(const field::SeasonConfig& field, mapping::EkfSlam* ekf);
-
-// The pose of the alliance's start_index-th starting tile (throws std::invalid_argument when
-// there is none).
-platform::Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance,
-                           int start_index);
 
 // The season with its fixed-position floor objects moved uniformly up to jitter_m (clear of
 // walls and structures), so no two seeds share a layout; preloads (objects on a starting

@@ -12,6 +12,7 @@
 #include "mapping/ekf_slam.h"
 #include "mapping/object_map.h"
 #include "mapping/object_tracker.h"
+#include "platform/field_geometry.h"
 #include "platform/recording.h"
 #include "vision/detector.h"
 
@@ -81,7 +82,7 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
                        Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal(),
                        ekf_options);
   const std::vector<int> marker_id = AddSurveyedMarkers(season, &ekf);
-  result.landmark_truth = SurveyedMarkers(season);
+  result.landmark_truth = platform::SurveyedMarkers(season);
   const vision::DetectorSetup landmark_detector =
       vision::LandmarkDetectorSetup(season, &robot.camera);
   const vision::DetectorSetup object_detector = vision::ObjectDetectorSetup(season, &robot.camera);

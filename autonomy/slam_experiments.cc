@@ -10,6 +10,7 @@
 #include "autonomy/match_world.h"
 #include "mapping/object_map.h"
 #include "platform/drive_script.h"
+#include "platform/field_geometry.h"
 #include "platform/sim_field.h"
 #include "platform/sim_renderer.h"
 #include "vision/detector.h"
@@ -82,7 +83,7 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
                        Eigen::Vector3d(1e-6, 1e-6, 1e-6).asDiagonal(), setup.ekf);
   // A marker is identified by its colour only when no other marker shares it; otherwise the
   // filter associates it by position.
-  const std::vector<int> marker_id = MarkerIds(field);
+  const std::vector<int> marker_id = platform::MarkerIds(field);
   if (setup.known_landmarks) {
     for (size_t i = 0; i < field.landmarks.size(); ++i) {
       ekf.AddKnownLandmark(

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "platform/field_geometry.h"
 #include "platform/sim_renderer.h"
 #include "platform/sim_world.h"
 

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "field_configs/summary.h"
+#include "platform/field_geometry.h"
 
 namespace slamo::platform {
 namespace {

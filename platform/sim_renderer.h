@@ -67,10 +67,6 @@ struct FrameTruth {
   cv::Mat ids;                           // CV_16UC1 per pixel, see kLandmarkIdBase
 };
 
-// Where a landmark is drawn: discs and squares as plates on the inner face of the nearest wall
-// (centre 5 mm off it), cylinders and spheres where the season puts them.
-Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& landmark);
-
 class SimRenderer {
  public:
   SimRenderer(const field::SeasonConfig& season, const field::CameraConfig& camera,

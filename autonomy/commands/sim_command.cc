@@ -16,6 +16,7 @@
 #include "field_configs/config_error.h"
 #include "field_configs/loader.h"
 #include "platform/drive_script.h"
+#include "platform/field_geometry.h"
 #include "platform/sim_drive.h"
 #include "platform/sim_field.h"
 #include "platform/sim_renderer.h"
