@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include "autonomy/sim_io.h"
 #include "platform/field_geometry.h"
 
 namespace slamo::autonomy {
@@ -226,10 +227,10 @@ void MatchWorld::MaybeSnapshot(bool force) {
   u.dy_m *= odometry_scale_;
   s.estimate = mapping::EkfSlam::Move(ekf_.pose(), u, nullptr, nullptr);
   s.covariance = ekf_.pose_covariance();
-  if (const platform::SimField* sim = io_->sim()) {
-    for (const platform::SimObject& o : sim->world().objects) {
+  if (const std::optional<std::vector<TrueObject>> truth = io_->TrueObjects()) {
+    for (const TrueObject& o : *truth) {
       if (o.held) continue;
-      s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.type->size_m / 2.0});
+      s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.radius_m});
     }
   }
   s.tracked = Belief().objects;

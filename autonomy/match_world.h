@@ -26,7 +26,6 @@
 #include "planning/planner.h"
 #include "platform/clock.h"
 #include "platform/drive_script.h"
-#include "platform/sim_field.h"
 #include "strategy/strategy.h"
 #include "strategy/travel_field.h"
 #include "vision/detector.h"
@@ -131,8 +130,6 @@ class MatchWorld {
   // The alliance's points now, when known (the simulator).
   std::optional<int> Points() const { return io_->Points(); }
   const field::SeasonConfig& field() const { return field_; }
-  // The simulated field; null on hardware.
-  const platform::SimField* sim() const { return io_->sim(); }
   RobotIo& io() { return *io_; }
   const RobotIo& io() const { return *io_; }
   const mapping::EkfSlam& ekf() const { return ekf_; }
