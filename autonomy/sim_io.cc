@@ -3,7 +3,7 @@
 #include <cmath>
 #include <vector>
 
-#include "platform/drive_script.h"
+#include "platform/sim_drive_script.h"
 #include "platform/sim_field.h"
 #include "platform/sim_gyro.h"
 #include "platform/sim_renderer.h"

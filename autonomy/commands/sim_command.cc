@@ -18,6 +18,7 @@
 #include "platform/drive_script.h"
 #include "platform/field_geometry.h"
 #include "platform/sim_drive.h"
+#include "platform/sim_drive_script.h"
 #include "platform/sim_field.h"
 #include "platform/sim_renderer.h"
 #include "platform/sim_world.h"

@@ -6,6 +6,7 @@
 
 #include "field_configs/loader.h"
 #include "platform/drive_script.h"
+#include "platform/sim_drive_script.h"
 #include "platform/sim_renderer.h"
 
 namespace slamo::platform {
