@@ -3,10 +3,10 @@
 #include <cmath>
 #include <vector>
 
-#include "platform/sim_drive_script.h"
-#include "platform/sim_field.h"
-#include "platform/sim_gyro.h"
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_drive_script.h"
+#include "platform/sim/sim_field.h"
+#include "platform/sim/sim_gyro.h"
+#include "platform/sim/sim_renderer.h"
 
 namespace slamo::autonomy {
 namespace {

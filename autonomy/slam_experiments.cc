@@ -11,9 +11,9 @@
 #include "mapping/object_map.h"
 #include "platform/drive_script.h"
 #include "platform/field_geometry.h"
-#include "platform/sim_drive_script.h"
-#include "platform/sim_field.h"
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_drive_script.h"
+#include "platform/sim/sim_field.h"
+#include "platform/sim/sim_renderer.h"
 #include "vision/detector.h"
 
 namespace slamo::autonomy {

@@ -24,7 +24,7 @@
 #include "platform/field_geometry.h"
 #include "platform/openni2_camera.h"
 #include "platform/recording.h"
-#include "platform/sim_recording.h"
+#include "platform/sim/sim_recording.h"
 
 namespace slamo::autonomy {
 namespace {

@@ -19,7 +19,7 @@
 #include "field_configs/loader.h"
 #include "platform/field_geometry.h"
 #include "platform/recording.h"
-#include "platform/sim_recording.h"
+#include "platform/sim/sim_recording.h"
 
 namespace slamo::autonomy {
 namespace {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "field_configs/loader.h"
-#include "platform/sim_drive_script.h"
+#include "platform/sim/sim_drive_script.h"
 
 namespace slamo::platform {
 namespace {

@@ -1,4 +1,4 @@
-#include "platform/sim_field.h"
+#include "platform/sim/sim_field.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "platform/sim_drive_script.h"
+#include "platform/sim/sim_drive_script.h"
 
 #include <utility>
 

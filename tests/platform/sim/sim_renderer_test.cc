@@ -1,4 +1,4 @@
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "field_configs/loader.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::platform {
 namespace {

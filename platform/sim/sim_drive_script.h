@@ -11,7 +11,7 @@
 #include "platform/clock.h"
 #include "platform/drive_base.h"
 #include "platform/drive_script.h"
-#include "platform/sim_drive.h"
+#include "platform/sim/sim_drive.h"
 
 namespace slamo::platform {
 

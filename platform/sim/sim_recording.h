@@ -12,7 +12,7 @@
 #include "platform/drive_base.h"
 #include "platform/drive_script.h"
 #include "platform/recording.h"
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_renderer.h"
 
 namespace slamo::platform {
 

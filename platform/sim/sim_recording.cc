@@ -1,11 +1,11 @@
-#include "platform/sim_recording.h"
+#include "platform/sim/sim_recording.h"
 
 #include <cmath>
 #include <string>
 
 #include "platform/clock.h"
-#include "platform/sim_drive_script.h"
-#include "platform/sim_field.h"
+#include "platform/sim/sim_drive_script.h"
+#include "platform/sim/sim_field.h"
 
 namespace slamo::platform {
 

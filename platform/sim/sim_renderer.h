@@ -22,7 +22,7 @@
 #include "field_configs/season_config.h"
 #include "platform/drive_base.h"
 #include "platform/rgbd.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::platform {
 

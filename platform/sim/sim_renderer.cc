@@ -1,4 +1,4 @@
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_renderer.h"
 
 #include "platform/camera_geometry.h"
 #include "platform/field_geometry.h"

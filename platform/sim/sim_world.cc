@@ -1,4 +1,4 @@
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 #include <algorithm>
 #include <array>
