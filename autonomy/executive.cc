@@ -9,6 +9,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "strategy/strategy.h"
 
@@ -20,6 +22,7 @@ using strategy::ActionKind;
 // Tracked objects against where the objects really are at the end.
 std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
   std::vector<ObjectReport> out;
+  const std::optional<std::vector<TrueObject>> truth = world.io().TrueObjects();
   for (const mapping::TrackedObject& o : world.slam().tracker().objects()) {
     if (!world.slam().tracker().Confirmed(o)) continue;
     ObjectReport r;
@@ -29,12 +32,12 @@ std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
     r.estimate_m = o.position_m;
     r.covariance = o.covariance;
     double best = 0.5;
-    if (world.sim() == nullptr) {  // no truth on hardware
+    if (!truth) {  // no truth on hardware
       out.push_back(r);
       continue;
     }
-    for (const platform::SimObject& t : world.sim()->world().objects) {
-      if (t.held || t.type->name != o.kind || t.colour != o.colour) continue;
+    for (const TrueObject& t : *truth) {
+      if (t.held || t.kind != o.kind || t.colour != o.colour) continue;
       const double e = (t.center_m.head<2>() - o.position_m).norm();
       if (e < best) best = e, r.matched = true, r.truth_m = t.center_m.head<2>(), r.error_m = e;
     }
@@ -108,7 +111,7 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
   result.frames = mapping::Describe(match_setup.frames);
   result.deadline_s = world.deadline_s();
   result.robot_io = world.io().Describe();
-  result.truth_known = world.sim() != nullptr;
+  result.truth_known = world.io().TrueObjects().has_value();
   result.points_start = world.Points().value_or(0);
 
   int idle_actions = 0;  // actions that took no time: a strategy going round in circles

@@ -103,7 +103,7 @@ void HardwareIo::Start(const field::SeasonConfig& field, const field::RobotConfi
       platform::kPi * robot.drive.wheel_diameter_m / robot.drive.encoder_ticks_per_rev,
       robot.drive.track_width_m, board_->ReadEncoders(), start);
   // The preload, as loaded by hand: the season's object of the alliance's colour under the
-  // robot's footprint nearest its centre (the simulator's rule, platform/sim_field.h).
+  // robot's footprint nearest its centre (the simulator's rule, platform/sim/sim_field.h).
   const double c = std::cos(start.theta_rad), s = std::sin(start.theta_rad);
   double best = std::numeric_limits<double>::infinity();
   for (const field::ObjectPlacement& p : field.objects) {

@@ -22,12 +22,12 @@
 
 #include "autonomy/robot_io.h"
 #include "platform/clock.h"
-#include "platform/fake_board.h"
 #include "platform/recording.h"
 #include "platform/rgbd.h"
 #include "platform/serial_drive_base.h"
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "platform/sim/fake_board.h"
+#include "platform/sim/sim_renderer.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::autonomy {
 
@@ -57,7 +57,7 @@ class RecordedStreamCamera : public platform::RgbdCamera {
   int64_t shown_ = -1;
 };
 
-// The simulated field's camera on the fake board (platform/fake_board.h): renders the field
+// The simulated field's camera on the fake board (platform/sim/fake_board.h): renders the field
 // (objects placed by CreateWorld for `seed`) from where the board's motor model has really
 // taken the robot: the start pose on the field composed with the motors' own pose, which
 // starts at the origin. A camera streaming at the robot's frame rate: a new frame once per

@@ -6,8 +6,8 @@
 
 #include <Eigen/Geometry>
 
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "autonomy/sim_io.h"
+#include "platform/field_geometry.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -16,7 +16,7 @@ using platform::DriveStep;
 using platform::DriveStepKind;
 using platform::Pose2D;
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 
 DriveStep Turn(double degrees) {
   return {DriveStepKind::kTurn, degrees, "turn " + std::to_string(degrees)};
@@ -24,16 +24,6 @@ DriveStep Turn(double degrees) {
 DriveStep Forward(double metres) {
   return {DriveStepKind::kDrive, metres,
           (metres >= 0 ? "forward " : "back ") + std::to_string(std::abs(metres))};
-}
-
-const field::StartTile& StartFor(const field::SeasonConfig& season, field::Alliance alliance,
-                                 int index) {
-  int seen = 0;
-  for (const field::StartTile& s : season.starts) {
-    if (s.alliance == alliance && seen++ == index) return s;
-  }
-  throw std::invalid_argument(season.name + " has no starting tile " + std::to_string(index) +
-                              " for that alliance");
 }
 
 // Frames taken to check an arrival, and how close counts as arrived.
@@ -58,41 +48,17 @@ field::RobotConfig MatchRobot(const field::RobotConfig& robot, double speed_mps)
 
 }  // namespace
 
-std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field) {
-  std::vector<Eigen::Vector2d> out;
-  for (const field::Landmark& l : field.landmarks)
-    out.push_back(platform::LandmarkCentre(field, l).head<2>());
-  return out;
-}
-
-std::vector<int> MarkerIds(const field::SeasonConfig& field) {
-  std::vector<int> marker_id(field.landmarks.size(), -1);
-  for (size_t i = 0; i < field.landmarks.size(); ++i) {
-    const auto same = std::count_if(
-        field.landmarks.begin(), field.landmarks.end(),
-        [&](const field::Landmark& l) { return l.colour == field.landmarks[i].colour; });
-    if (same == 1) marker_id[i] = static_cast<int>(i);
-  }
-  return marker_id;
-}
-
 mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
                             const platform::Pose2D& start, bool relocalise) {
   mapping::SlamOPrior prior;
   prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
   prior.covariance = Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal();
-  prior.surveyed_markers = SurveyedMarkers(field);
+  prior.surveyed_markers = platform::SurveyedMarkers(field);
   prior.marker_sigma_m = 1e-3;
   mapping::SlamOOptions options;
   options.ekf.add_landmarks = false;
   options.relocalise = relocalise;
   return mapping::SlamO(field, robot.camera, prior, options);
-}
-
-platform::Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance,
-                           int start_index) {
-  const field::StartTile& start = StartFor(season, alliance, start_index);
-  return {start.center_m.x, start.center_m.y, start.heading_deg * kPi / 180.0};
 }
 
 field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m,
@@ -138,12 +104,12 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
       perceive_(perceive),
       deadline_s_(season.rules.autonomous_s),
       io_(std::move(io)),
-      slam_(
-          SurveyedSlam(field_, robot_, StartPose(field_, setup.alliance, setup.start_index), true)),
+      slam_(SurveyedSlam(field_, robot_,
+                         platform::StartPose(field_, setup.alliance, setup.start_index), true)),
       travel_(robot_.drive) {
-  const Pose2D start_pose = StartPose(field_, setup.alliance, setup.start_index);
+  const Pose2D start_pose = platform::StartPose(field_, setup.alliance, setup.start_index);
   io_->Start(field_, robot_, start_pose);
-  markers_ = SurveyedMarkers(field_);
+  markers_ = platform::SurveyedMarkers(field_);
   // The preload: loaded by hand, so its kind and colour are known.
   if (const std::optional<IntakeItem> preload = io_->Preload()) {
     strategy::ObjectBelief held;
@@ -241,10 +207,10 @@ void MatchWorld::MaybeSnapshot(bool force) {
   u.dy_m *= odometry_scale_;
   s.estimate = mapping::EkfSlam::Move(slam_.pose(), u, nullptr, nullptr);
   s.covariance = slam_.pose_covariance();
-  if (const platform::SimField* sim = io_->sim()) {
-    for (const platform::SimObject& o : sim->world().objects) {
+  if (const std::optional<std::vector<TrueObject>> truth = io_->TrueObjects()) {
+    for (const TrueObject& o : *truth) {
       if (o.held) continue;
-      s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.type->size_m / 2.0});
+      s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.radius_m});
     }
   }
   s.tracked = Belief().objects;

@@ -24,7 +24,6 @@
 #include "planning/planner.h"
 #include "platform/clock.h"
 #include "platform/drive_script.h"
-#include "platform/sim_field.h"
 #include "strategy/strategy.h"
 #include "strategy/travel_field.h"
 
@@ -128,8 +127,6 @@ class MatchWorld {
   // The alliance's points now, when known (the simulator).
   std::optional<int> Points() const { return io_->Points(); }
   const field::SeasonConfig& field() const { return field_; }
-  // The simulated field; null on hardware.
-  const platform::SimField* sim() const { return io_->sim(); }
   RobotIo& io() { return *io_; }
   const RobotIo& io() const { return *io_; }
   // SLAM-O: the EKF, the object tracker and the maps.
@@ -187,22 +184,11 @@ class MatchWorld {
   int replans_ = 0;
 };
 
-// The surveyed perimeter markers' centres: where the renderer draws them (a plate's centre
-// sits just off its wall), which is where a team's tape measure puts them.
-std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field);
-// Each marker's id in the filter: its index when no other marker shares its colour, else -1
-// (associated by position).
-std::vector<int> MarkerIds(const field::SeasonConfig& field);
 // SLAM-O as a match runs it: from `start`, known to a centimetre and a degree, over the
 // season's surveyed markers, known to a millimetre and all there is (no new landmarks); with
 // `relocalise`, a belief that left the truth is widened and paired again.
 mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
                             const platform::Pose2D& start, bool relocalise);
-
-// The pose of the alliance's start_index-th starting tile (throws std::invalid_argument when
-// there is none).
-platform::Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance,
-                           int start_index);
 
 // The season with its fixed-position floor objects moved uniformly up to jitter_m (clear of
 // walls and structures), so no two seeds share a layout; preloads (objects on a starting

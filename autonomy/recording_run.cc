@@ -10,6 +10,7 @@
 
 #include "autonomy/match_world.h"
 #include "mapping/slam_o.h"
+#include "platform/field_geometry.h"
 #include "platform/recording.h"
 
 namespace slamo::autonomy {
@@ -64,7 +65,7 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
   // SLAM-O at the first true pose (else the first red tile), over the surveyed markers.
   const Pose2D start = has_truth ? truth.front().pose : FirstRedStart(season);
   mapping::SlamO slam = SurveyedSlam(season, robot, start, /*relocalise=*/false);
-  result.landmark_truth = SurveyedMarkers(season);
+  result.landmark_truth = platform::SurveyedMarkers(season);
 
   // Wheel geometry: the recording's, else the robot file's.
   double metres_per_tick = reader->info().metres_per_tick;

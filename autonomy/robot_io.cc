@@ -1,103 +1,6 @@
 #include "autonomy/robot_io.h"
 
-#include <cmath>
-#include <vector>
-
-#include "platform/drive_script.h"
-#include "platform/sim_gyro.h"
-#include "platform/sim_renderer.h"
-
 namespace slamo::autonomy {
-namespace {
-
-using platform::Pose2D;
-
-// What a team measures before it trusts its encoders: drive 1 m straight a few times on an
-// empty floor and compare the true distance (a tape measure) with what the encoders say. The
-// mean ratio scales every commanded distance and every odometry increment; SLAM-O is left the
-// random part of the slip.
-double CalibrateOdometryScale(const field::RobotConfig& robot) {
-  double ratio = 0.0;
-  const int runs = 5;
-  for (int i = 0; i < runs; ++i) {
-    const std::vector<platform::DriveStepResult> r =
-        platform::SimulateDriveScript("forward 1.0", robot, platform::SimDriveOptions{}, 1000 + i);
-    const double truth = std::hypot(r.back().true_pose.x_m, r.back().true_pose.y_m);
-    const double encoders = std::hypot(r.back().odometry_pose.x_m, r.back().odometry_pose.y_m);
-    ratio += truth / encoders;
-  }
-  return ratio / runs;
-}
-
-class SimIo : public RobotIo {
- public:
-  SimIo(field::Alliance alliance, uint64_t seed) : alliance_(alliance), seed_(seed), gyro_(seed) {}
-
-  void Start(const field::SeasonConfig& field, const field::RobotConfig& robot,
-             const Pose2D& start) override {
-    robot_ = robot;
-    platform::SimFieldOptions options;
-    options.preload = true;
-    sim_ = std::make_unique<platform::SimField>(field, robot, alliance_, seed_, start,
-                                                platform::SimDriveOptions{}, options);
-    renderer_ = std::make_unique<platform::SimRenderer>(field, robot.camera,
-                                                        platform::RenderOptions{}, seed_);
-  }
-  const platform::Clock& clock() const override { return clock_; }
-  platform::DriveBase& drive() override { return sim_->drive(); }
-  void Advance(double dt_s) override {
-    sim_->Step(dt_s);
-    clock_.Advance(dt_s);
-  }
-  Pose2D OdometryPose() const override { return sim_->drive().odometry_pose(); }
-  bool MotorsDriven() const override {
-    const platform::SimDriveBase& d = sim_->drive();
-    return d.left_pwm() != robot_.drive.pwm.stop || d.right_pwm() != robot_.drive.pwm.stop;
-  }
-  std::optional<double> GyroHeadingRad() override {
-    return gyro_.Read(sim_->robot_pose().theta_rad, clock_.NowS());
-  }
-  std::optional<platform::RgbdFrame> Capture() override {
-    return renderer_->Render(sim_->world(), sim_->robot_pose(), clock_.NowS(), nullptr);
-  }
-  std::optional<IntakeItem> Pick(const strategy::ObjectBelief&) override {
-    const std::optional<int> picked = sim_->Pick();
-    if (!picked) return std::nullopt;
-    return Item(*picked);  // the intake knows what it took (its own colour sensor)
-  }
-  std::optional<ReleaseOutcome> Release(int) override {
-    const std::optional<platform::ReleaseResult> released = sim_->Release();
-    if (!released) return std::nullopt;
-    return ReleaseOutcome{released->goal_index, false};
-  }
-  std::optional<IntakeItem> Preload() const override {
-    if (sim_->held().empty()) return std::nullopt;
-    return Item(sim_->held().front());
-  }
-  double OdometryScale() override { return CalibrateOdometryScale(robot_); }
-  std::optional<Pose2D> TruePose() const override { return sim_->robot_pose(); }
-  std::optional<int> Points() const override { return sim_->Score(alliance_); }
-  const platform::SimField* sim() const override { return sim_.get(); }
-  std::string Describe() const override { return "simulated field"; }
-
- private:
-  std::optional<IntakeItem> Item(int id) const {
-    for (const platform::SimObject& o : sim_->world().objects) {
-      if (o.id == id) return IntakeItem{o.type->name, o.colour, false};
-    }
-    return std::nullopt;
-  }
-
-  field::Alliance alliance_;
-  uint64_t seed_;
-  field::RobotConfig robot_;
-  platform::SimClock clock_;
-  std::unique_ptr<platform::SimField> sim_;
-  std::unique_ptr<platform::SimRenderer> renderer_;
-  platform::SimGyro gyro_;
-};
-
-}  // namespace
 
 platform::DriveBodyLink DriveLinkFor(RobotIo& io, const field::RobotConfig& robot) {
   platform::DriveBodyLink body;
@@ -110,10 +13,6 @@ platform::DriveBodyLink DriveLinkFor(RobotIo& io, const field::RobotConfig& robo
   body.advance = [&io](double dt_s) { io.Advance(dt_s); };
   if (io.TruePose()) body.truth = [&io]() { return *io.TruePose(); };
   return body;
-}
-
-std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed) {
-  return std::make_unique<SimIo>(alliance, seed);
 }
 
 }  // namespace slamo::autonomy

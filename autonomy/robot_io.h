@@ -11,6 +11,9 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include "field_configs/robot_config.h"
 #include "field_configs/season_config.h"
@@ -18,10 +21,21 @@
 #include "platform/drive_base.h"
 #include "platform/drive_script.h"
 #include "platform/rgbd.h"
-#include "platform/sim_field.h"
 #include "strategy/strategy.h"
 
 namespace slamo::autonomy {
+
+// An object where it really is, when that is known (the simulator): for the report and the
+// replay, never for steering.
+struct TrueObject {
+  int id = 0;  // 1-based, stable for the run
+  std::string kind;
+  std::string colour;
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  // centre of the object's bounding box
+  double radius_m = 0.0;                               // half the object type's size
+  bool held = false;                                   // in the robot's intake: not on the field
+  int in_goal = -1;  // index into SeasonConfig::goals when released into a goal structure
+};
 
 // What the intake holds after a pick (or the preload).
 struct IntakeItem {
@@ -71,7 +85,8 @@ class RobotIo {
   // The truth, where it is known (the simulator).
   virtual std::optional<platform::Pose2D> TruePose() const = 0;
   virtual std::optional<int> Points() const = 0;
-  virtual const platform::SimField* sim() const { return nullptr; }
+  // Every object of the field (held ones too), in a fixed order; nothing on hardware.
+  virtual std::optional<std::vector<TrueObject>> TrueObjects() const { return std::nullopt; }
   // For reports: "simulated field", "board /dev/ttyACM0, camera recording rec/", ...
   virtual std::string Describe() const = 0;
   // Counters for the report (link losses, frames missed, ...); none on the simulator.
@@ -81,10 +96,5 @@ class RobotIo {
 // The drive controller's link to io's drive base (RunDriveScript): the robot's wheel geometry,
 // the match clock, io.Advance as the passing of time, io's truth when it has one.
 platform::DriveBodyLink DriveLinkFor(RobotIo& io, const field::RobotConfig& robot);
-
-// The simulated field of a dry run: SimField (drive base with slip, objects, opponents,
-// intake, scoring), its camera renderer and a yaw gyro, all seeded by `seed`; time on a
-// SimClock, so a dry run goes as fast as the computer allows and replays exactly.
-std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed);
 
 }  // namespace slamo::autonomy

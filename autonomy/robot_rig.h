@@ -13,9 +13,9 @@
 #include "field_configs/robot_config.h"
 #include "field_configs/season_config.h"
 #include "platform/clock.h"
-#include "platform/fake_board.h"
 #include "platform/recording.h"
 #include "platform/serial_drive_base.h"
+#include "platform/sim/fake_board.h"
 
 namespace slamo::autonomy {
 

@@ -9,8 +9,9 @@
 
 #include "mapping/slam_o.h"
 #include "platform/drive_script.h"
-#include "platform/sim_field.h"
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_drive_script.h"
+#include "platform/sim/sim_field.h"
+#include "platform/sim/sim_renderer.h"
 
 namespace slamo::autonomy {
 

@@ -9,8 +9,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "platform/field_geometry.h"
+#include "platform/sim/sim_renderer.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::autonomy {
 namespace {

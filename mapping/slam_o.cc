@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "platform/field_geometry.h"
+
 namespace slamo::mapping {
-namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-}  // namespace
+using platform::kPi;
 
 OdometryStep OdometryIncrement(const platform::Pose2D& from, const platform::Pose2D& to) {
   const double c = std::cos(from.theta_rad), s = std::sin(from.theta_rad);
@@ -30,13 +29,7 @@ SlamO::SlamO(const field::SeasonConfig& season, const field::CameraConfig& camer
   // A marker is identified by its colour only when no other marker shares it; otherwise the
   // filter associates it by position.
   const std::vector<field::Landmark>& landmarks = season_.landmarks;
-  marker_id_.assign(landmarks.size(), -1);
-  for (size_t i = 0; i < landmarks.size(); ++i) {
-    const auto same =
-        std::count_if(landmarks.begin(), landmarks.end(),
-                      [&](const field::Landmark& l) { return l.colour == landmarks[i].colour; });
-    if (same == 1) marker_id_[i] = static_cast<int>(i);
-  }
+  marker_id_ = platform::MarkerIds(season_);
   for (size_t i = 0; i < landmarks.size() && i < prior.surveyed_markers.size(); ++i) {
     ekf_.AddKnownLandmark(prior.surveyed_markers[i],
                           Eigen::Matrix2d::Identity() * prior.marker_sigma_m * prior.marker_sigma_m,

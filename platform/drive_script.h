@@ -1,7 +1,8 @@
-// Drive scripts: "forward 0.3; turn 90; back 0.2; wait 1" parsed into steps and driven on the
-// simulated drive base by a closed-loop controller that knows only the encoders (turn, then
-// drive holding heading, with speed ramps), the way the real robot will be driven. After each
-// step the result holds the true pose and the encoder-odometry pose.
+// Drive scripts: "forward 0.3; turn 90; back 0.2; wait 1" parsed into steps and driven on any
+// DriveBase (the simulator's: platform/sim/sim_drive_script.h) by a closed-loop controller that
+// knows only the encoders (turn, then drive holding heading, with speed ramps), the way the real
+// robot will be driven. After each step the result holds the true pose and the encoder-odometry
+// pose.
 #pragma once
 
 #include <cstdint>
@@ -14,7 +15,6 @@
 #include "field_configs/robot_config.h"
 #include "platform/clock.h"
 #include "platform/drive_base.h"
-#include "platform/sim_drive.h"
 
 namespace slamo::platform {
 
@@ -96,21 +96,5 @@ struct DriveBodyLink {
 std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
                                             const DriveControllerOptions& options,
                                             const DriveBodyLink& body);
-
-// Drives `steps` on `sim`, advancing `clock` in lockstep with it. Headings are tracked
-// against the intended heading, so a turn also corrects the previous turn's encoder error.
-// `advance` steps the simulation (default: sim->Step); a SimField passes its own Step so
-// objects and opponents move with the robot.
-std::vector<DriveStepResult> RunDriveScript(const std::vector<DriveStep>& steps,
-                                            const DriveControllerOptions& options,
-                                            SimDriveBase* sim, SimClock* clock,
-                                            std::function<void(double)> advance = nullptr);
-
-// For the command line: parses `script` (throws DriveScriptError), builds the robot's
-// simulated drive base with `sim_options` and `seed` at `start` (collisions through the
-// optional `is_free`, see SimDriveBase::SetFreeSpaceCheck), and runs it.
-std::vector<DriveStepResult> SimulateDriveScript(
-    const std::string& script, const field::RobotConfig& robot, const SimDriveOptions& sim_options,
-    uint64_t seed, const Pose2D& start = {}, std::function<bool(const Pose2D&)> is_free = nullptr);
 
 }  // namespace slamo::platform

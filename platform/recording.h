@@ -17,7 +17,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -27,9 +26,7 @@
 #include "field_configs/robot_config.h"
 #include "field_configs/season_config.h"
 #include "platform/drive_base.h"
-#include "platform/drive_script.h"
 #include "platform/rgbd.h"
-#include "platform/sim_renderer.h"
 
 namespace slamo::platform {
 
@@ -125,33 +122,5 @@ std::unique_ptr<RecordingReader> OpenTumRecording(const std::string& dir,
 std::unique_ptr<RecordingReader> OpenRawlogRecording(const std::string& path);
 // A folder is read as TUM, a file as a rawlog.
 std::unique_ptr<RecordingReader> OpenRecording(const std::string& path);
-
-// ---- The simulator as the recorder ----
-
-struct SimRecordingOptions {
-  uint64_t seed = 1;
-  Pose2D start;                  // robot start pose on the field
-  std::string script;            // a drive script (see ParseDriveScript)
-  double fps = 5.0;              // camera frames per second of simulated time
-  double encoder_rate_hz = 0.0;  // encoder and ground-truth readings; 0 = every control tick
-  RenderOptions render;
-};
-
-struct SimRecordingSummary {
-  int frames = 0;
-  int encoder_readings = 0;
-  int ground_truth_poses = 0;
-  double duration_s = 0.0;
-  std::vector<DriveStepResult> steps;
-};
-
-// Drives `options.script` on the whole simulated field (SimField: objects, opponents), renders
-// the camera at options.fps from the start (t = 0) and logs encoders and the true pose, into
-// every writer (not closed here). `progress`, when given, is called after each frame.
-// Throws DriveScriptError for a bad script, RecordingError for a write failure.
-SimRecordingSummary RecordSimulatedRun(
-    const field::SeasonConfig& season, const field::RobotConfig& robot,
-    const SimRecordingOptions& options, const std::vector<RecordingWriter*>& writers,
-    const std::function<void(const SimRecordingSummary&, double t_s)>& progress = nullptr);
 
 }  // namespace slamo::platform

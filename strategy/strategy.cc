@@ -9,12 +9,12 @@
 #include <Eigen/Eigenvalues>
 
 #include "field_configs/summary.h"
-#include "platform/sim_world.h"
+#include "platform/field_geometry.h"
 
 namespace slamo::strategy {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 // A staging pose within this distance counts as reached.
 constexpr double kAtStage_m = 0.25;
 

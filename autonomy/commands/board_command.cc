@@ -14,8 +14,8 @@
 #include "autonomy/commands/commands.h"
 #include "field_configs/loader.h"
 #include "platform/clock.h"
-#include "platform/fake_board.h"
 #include "platform/serial_drive_base.h"
+#include "platform/sim/fake_board.h"
 
 namespace slamo::autonomy {
 namespace {

@@ -20,7 +20,7 @@
 #include "autonomy/commands/commands.h"
 #include "field_configs/loader.h"
 #include "mapping/object_map.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::autonomy {
 namespace {

@@ -30,6 +30,7 @@
 #include "autonomy/robot_rig.h"
 #include "field_configs/loader.h"
 #include "mapping/frame_selection.h"
+#include "platform/field_geometry.h"
 #include "platform/openni2_camera.h"
 #include "platform/recording.h"
 #include "strategy/strategy.h"
@@ -79,7 +80,7 @@ int Match(const MatchArgs& args) {
       throw std::invalid_argument("--alliance: expected red or blue, got \"" + args.alliance +
                                   "\"");
     setup.alliance = args.alliance == "red" ? field::Alliance::kRed : field::Alliance::kBlue;
-    StartPose(season, setup.alliance, setup.start_index);
+    platform::StartPose(season, setup.alliance, setup.start_index);
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
@@ -104,7 +105,7 @@ int Match(const MatchArgs& args) {
   std::unique_ptr<platform::RecordingWriter> recorder;
   try {
     rig = std::make_unique<Rig>(rig_options, season, robot,
-                                StartPose(season, setup.alliance, setup.start_index));
+                                platform::StartPose(season, setup.alliance, setup.start_index));
     if (!CreateOutputDir(args.out)) return 1;
     if (!args.record.empty()) {
       platform::RecordingInfo info = platform::RecordingInfoFor(robot);

@@ -22,7 +22,7 @@
 #include "mapping/object_map.h"
 #include "planning/export.h"
 #include "planning/planner.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::autonomy {
 namespace {

@@ -21,9 +21,10 @@
 #include "field_configs/loader.h"
 #include "platform/clock.h"
 #include "platform/drive_script.h"
+#include "platform/field_geometry.h"
 #include "platform/openni2_camera.h"
 #include "platform/recording.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_recording.h"
 
 namespace slamo::autonomy {
 namespace {

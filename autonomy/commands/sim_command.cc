@@ -16,10 +16,12 @@
 #include "field_configs/config_error.h"
 #include "field_configs/loader.h"
 #include "platform/drive_script.h"
-#include "platform/sim_drive.h"
-#include "platform/sim_field.h"
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "platform/field_geometry.h"
+#include "platform/sim/sim_drive.h"
+#include "platform/sim/sim_drive_script.h"
+#include "platform/sim/sim_field.h"
+#include "platform/sim/sim_renderer.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::autonomy {
 namespace {

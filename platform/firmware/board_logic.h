@@ -1,7 +1,7 @@
 // The motor-controller board's logic, hardware-free: the protocol endpoint, the per-side PID
 // speed loop (with speed feedforward through the servo PWM curve) and the link watchdog.
 // The Arduino Mega 2560 firmware (slamo_board/slamo_board.ino) and the host's fake board
-// (platform/fake_board.cc) both compile this header, so the fake board runs exactly the code
+// (platform/sim/fake_board.cc) both compile this header, so the fake board runs exactly the code
 // the board runs; only the I/O around it differs (UART + Timer PWM + I2C encoders there, a
 // pseudo-terminal + the simulator's motor model here).
 //

@@ -17,7 +17,9 @@
 
 #include "autonomy/executive.h"
 #include "field_configs/loader.h"
+#include "platform/field_geometry.h"
 #include "platform/recording.h"
+#include "platform/sim/sim_recording.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -71,7 +73,7 @@ TEST(HardwareMatch, ClosesTheLoopOverTheFakeBoardsSerialLink) {
   const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
   const MatchSetup setup = HardwareSetup();
   Bench bench(robot);
-  const platform::Pose2D start = StartPose(season, setup.alliance, 0);
+  const platform::Pose2D start = platform::StartPose(season, setup.alliance, 0);
   FakeBoardCamera camera(season, robot, bench.board.board(), start, bench.clock, 1);
   HardwareIoOptions options;
   options.truth = [&]() { return std::optional<platform::Pose2D>(camera.Truth()); };
@@ -112,7 +114,7 @@ TEST(HardwareMatch, SurvivesAnUnpluggedCableAndANoisyLink) {
   board_options.faults.garbage_probability = 0.02;
   board_options.faults.duplicate_probability = 0.02;
   Bench bench(robot, board_options);
-  const platform::Pose2D start = StartPose(season, setup.alliance, 0);
+  const platform::Pose2D start = platform::StartPose(season, setup.alliance, 0);
   FakeBoardCamera camera(season, robot, bench.board.board(), start, bench.clock, 2);
   // The cable comes out for 0.3 s while the robot drives (at 3 s on the board's clock).
   double unplugged_s = -1.0;

@@ -12,6 +12,7 @@
 #include "autonomy/match_report.h"
 #include "field_configs/loader.h"
 #include "platform/recording.h"
+#include "platform/sim/sim_recording.h"
 
 namespace slamo::autonomy {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "field_configs/loader.h"
 #include "mapping/object_map.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::mapping {
 namespace {

@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "field_configs/loader.h"
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_renderer.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::mapping {
 namespace {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "field_configs/loader.h"
+#include "platform/sim/sim_drive_script.h"
 
 namespace slamo::platform {
 namespace {

@@ -25,6 +25,7 @@
 
 #include "field_configs/loader.h"
 #include "platform/drive_script.h"
+#include "platform/sim/sim_recording.h"
 
 namespace slamo::platform {
 namespace {

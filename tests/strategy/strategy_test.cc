@@ -5,7 +5,6 @@
 #include "field_configs/loader.h"
 #include "mapping/object_map.h"
 #include "planning/planner.h"
-#include "platform/sim_world.h"
 #include "strategy/travel_field.h"
 
 namespace slamo::strategy {

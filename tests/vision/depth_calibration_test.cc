@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "field_configs/loader.h"
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_renderer.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::vision {
 namespace {

@@ -6,7 +6,7 @@
 #include <map>
 
 #include "field_configs/loader.h"
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_renderer.h"
 #include "vision/detector.h"
 
 namespace slamo::vision {

@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "field_configs/loader.h"
-#include "platform/sim_renderer.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_renderer.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::vision {
 namespace {

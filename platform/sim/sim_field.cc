@@ -1,10 +1,11 @@
-#include "platform/sim_field.h"
+#include "platform/sim/sim_field.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "field_configs/summary.h"
+#include "platform/field_geometry.h"
 
 namespace slamo::platform {
 namespace {

@@ -1,4 +1,4 @@
-#include "platform/fake_board.h"
+#include "platform/sim/fake_board.h"
 
 #include <fcntl.h>
 #include <pty.h>

@@ -1,4 +1,4 @@
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "field_configs/loader.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::platform {
 namespace {
@@ -226,14 +226,6 @@ TEST_F(SimRendererTest, SemiTransparentBallDefeatsAHueThreshold) {
   };
   EXPECT_GT(fraction_blue(1), 0.9);  // solid: the threshold finds nearly all of it
   EXPECT_LT(fraction_blue(2), 0.7);  // semi-transparent: much of the body is missed
-}
-
-TEST(FootprintTest, WallsAndStructuresBlock) {
-  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
-  EXPECT_TRUE(FootprintIsFree(season, {-1.5, 0.3, 0.0}, 0.45, 0.42));
-  EXPECT_FALSE(FootprintIsFree(season, {-1.7, 0.3, 0.0}, 0.45, 0.42));   // through the wall
-  EXPECT_FALSE(FootprintIsFree(season, {0.45, 0.61, 0.0}, 0.45, 0.42));  // on the red goal
-  EXPECT_TRUE(FootprintIsFree(season, {-0.3, 0.0, 0.0}, 0.45, 0.42));    // the bump is drivable
 }
 
 }  // namespace

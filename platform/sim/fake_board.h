@@ -19,7 +19,7 @@
 #include "field_configs/robot_config.h"
 #include "platform/firmware/board_logic.h"
 #include "platform/serial_protocol.h"
-#include "platform/sim_drive.h"
+#include "platform/sim/sim_drive.h"
 
 namespace slamo::platform {
 

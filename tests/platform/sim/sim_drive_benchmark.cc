@@ -4,7 +4,8 @@
 
 #include "field_configs/loader.h"
 #include "platform/drive_script.h"
-#include "platform/sim_drive.h"
+#include "platform/sim/sim_drive.h"
+#include "platform/sim/sim_drive_script.h"
 
 namespace slamo::platform {
 namespace {

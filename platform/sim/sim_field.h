@@ -13,8 +13,8 @@
 
 #include "field_configs/robot_config.h"
 #include "field_configs/season_config.h"
-#include "platform/sim_drive.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_drive.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::platform {
 

@@ -1,4 +1,4 @@
-#include "platform/sim_field.h"
+#include "platform/sim/sim_field.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,8 @@
 
 #include "field_configs/loader.h"
 #include "platform/drive_script.h"
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_drive_script.h"
+#include "platform/sim/sim_renderer.h"
 
 namespace slamo::platform {
 namespace {

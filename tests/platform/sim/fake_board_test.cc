@@ -1,7 +1,7 @@
 // The host driver against the fake board (the firmware's logic on the simulator's motors):
 // on simulated time through an in-memory link for the timing requirements, and through a
 // real pseudo-terminal and MRPT's serial port for unplug / replug.
-#include "platform/fake_board.h"
+#include "platform/sim/fake_board.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -22,7 +22,7 @@
 #include "field_configs/season_config.h"
 #include "platform/drive_base.h"
 #include "platform/rgbd.h"
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 namespace slamo::platform {
 
@@ -66,10 +66,6 @@ struct FrameTruth {
   std::vector<LandmarkTruth> landmarks;  // those with at least one visible pixel
   cv::Mat ids;                           // CV_16UC1 per pixel, see kLandmarkIdBase
 };
-
-// Where a landmark is drawn: discs and squares as plates on the inner face of the nearest wall
-// (centre 5 mm off it), cylinders and spheres where the season puts them.
-Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& landmark);
 
 class SimRenderer {
  public:

@@ -1,4 +1,4 @@
-#include "platform/sim_drive.h"
+#include "platform/sim/sim_drive.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,7 @@
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_renderer.h"
 
 #include "platform/camera_geometry.h"
+#include "platform/field_geometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -325,20 +326,6 @@ struct SimRenderer::Buffers {
     std::fill(id.begin(), id.end(), uint16_t{0});
   }
 };
-
-Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& l) {
-  if (l.shape != field::LandmarkShape::kDisc && l.shape != field::LandmarkShape::kSquare)
-    return Vector3d(l.position_m.x, l.position_m.y, l.height_m);
-  // A plate: on the inner face of the nearest wall.
-  const double inset = season.HalfSize() - 0.005;
-  double x = l.position_m.x, y = l.position_m.y;
-  if (std::abs(l.position_m.x) >= std::abs(l.position_m.y)) {
-    x = std::clamp(x, -inset, inset);
-  } else {
-    y = std::clamp(y, -inset, inset);
-  }
-  return Vector3d(x, y, l.height_m);
-}
 
 SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraConfig& camera,
                          RenderOptions options, uint64_t seed)

@@ -3,7 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include "field_configs/loader.h"
-#include "platform/sim_renderer.h"
+#include "platform/sim/sim_renderer.h"
 
 namespace slamo::platform {
 namespace {

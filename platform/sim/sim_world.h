@@ -49,16 +49,4 @@ struct SimWorld {
 // other objects and blocking structures) and picks the lighting from `seed`.
 SimWorld CreateWorld(const field::SeasonConfig& season, uint64_t seed);
 
-// True when a rectangle footprint at `pose` (length along the heading) is inside the
-// perimeter and clear of every structure that blocks robots.
-bool FootprintIsFree(const field::SeasonConfig& season, const Pose2D& pose, double length_m,
-                     double width_m);
-
-// True when the point lies on a structure that blocks robots (and objects).
-bool PointInBlockingStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p,
-                              double clearance_m);
-
-// True when the point lies inside a goal's footprint (box with yaw, or cylinder).
-bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p);
-
 }  // namespace slamo::platform

@@ -1,28 +1,17 @@
-#include "platform/sim_world.h"
+#include "platform/sim/sim_world.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
 
+#include "platform/field_geometry.h"
+
 namespace slamo::platform {
 namespace {
 
 using field::SeasonConfig;
-using field::SolidShape;
 using field::Structure;
-
-// Distance from point p to a structure's footprint in the plane (0 inside).
-double DistanceToStructure(const Structure& s, const Eigen::Vector2d& p) {
-  const Eigen::Vector2d d = p - Eigen::Vector2d(s.center_m.x, s.center_m.y);
-  if (s.shape == SolidShape::kCylinder) return std::max(0.0, d.norm() - s.radius_m);
-  const double yaw = s.yaw_deg * kPi / 180.0;
-  const double lx = std::cos(yaw) * d.x() + std::sin(yaw) * d.y();
-  const double ly = -std::sin(yaw) * d.x() + std::cos(yaw) * d.y();
-  const double ex = std::max(0.0, std::abs(lx) - s.size_m.x / 2.0);
-  const double ey = std::max(0.0, std::abs(ly) - s.size_m.y / 2.0);
-  return std::hypot(ex, ey);
-}
 
 double ObjectHeight(const field::ObjectType& type) { return type.height_m; }
 
@@ -96,47 +85,6 @@ SimWorld CreateWorld(const SeasonConfig& season, uint64_t seed) {
     world.opponents.push_back(opponent);
   }
   return world;
-}
-
-bool PointInBlockingStructure(const SeasonConfig& season, const Eigen::Vector2d& p,
-                              double clearance_m) {
-  for (const Structure& s : season.structures) {
-    if (s.blocks_robot && DistanceToStructure(s, p) <= clearance_m) return true;
-  }
-  return false;
-}
-
-bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p) {
-  const Eigen::Vector2d d = p - Eigen::Vector2d(goal.center_m.x, goal.center_m.y);
-  if (goal.shape == SolidShape::kCylinder) return d.norm() <= goal.radius_m;
-  const double yaw = goal.yaw_deg * kPi / 180.0;
-  const double lx = std::cos(yaw) * d.x() + std::sin(yaw) * d.y();
-  const double ly = -std::sin(yaw) * d.x() + std::cos(yaw) * d.y();
-  return std::abs(lx) <= goal.size_m.x / 2.0 && std::abs(ly) <= goal.size_m.y / 2.0;
-}
-
-bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double length_m,
-                     double width_m) {
-  const double c = std::cos(pose.theta_rad);
-  const double s = std::sin(pose.theta_rad);
-  // Sample the footprint's outline and centre line densely enough for the thinnest posts.
-  const double step = 0.02;
-  const double half = season.HalfSize();
-  const int nx = static_cast<int>(std::ceil(length_m / step));
-  const int ny = static_cast<int>(std::ceil(width_m / step));
-  for (int i = 0; i <= nx; ++i) {
-    for (int j = 0; j <= ny; ++j) {
-      if (i != 0 && i != nx && j != 0 && j != ny && j != ny / 2) continue;
-      const double lx = -length_m / 2.0 + length_m * i / nx;
-      const double ly = -width_m / 2.0 + width_m * j / ny;
-      const Eigen::Vector2d p(pose.x_m + c * lx - s * ly, pose.y_m + s * lx + c * ly);
-      if (std::abs(p.x()) > half || std::abs(p.y()) > half) return false;
-      for (const Structure& st : season.structures) {
-        if (st.blocks_robot && DistanceToStructure(st, p) <= 0.0) return false;
-      }
-    }
-  }
-  return true;
 }
 
 }  // namespace slamo::platform

@@ -1,0 +1,117 @@
+#include "platform/field_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace slamo::platform {
+namespace {
+
+using field::SeasonConfig;
+using field::SolidShape;
+using field::Structure;
+
+const field::StartTile& StartFor(const field::SeasonConfig& season, field::Alliance alliance,
+                                 int index) {
+  int seen = 0;
+  for (const field::StartTile& s : season.starts) {
+    if (s.alliance == alliance && seen++ == index) return s;
+  }
+  throw std::invalid_argument(season.name + " has no starting tile " + std::to_string(index) +
+                              " for that alliance");
+}
+
+}  // namespace
+
+double DistanceToStructure(const Structure& s, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d d = p - Eigen::Vector2d(s.center_m.x, s.center_m.y);
+  if (s.shape == SolidShape::kCylinder) return std::max(0.0, d.norm() - s.radius_m);
+  const double yaw = s.yaw_deg * kPi / 180.0;
+  const double lx = std::cos(yaw) * d.x() + std::sin(yaw) * d.y();
+  const double ly = -std::sin(yaw) * d.x() + std::cos(yaw) * d.y();
+  const double ex = std::max(0.0, std::abs(lx) - s.size_m.x / 2.0);
+  const double ey = std::max(0.0, std::abs(ly) - s.size_m.y / 2.0);
+  return std::hypot(ex, ey);
+}
+
+bool PointInBlockingStructure(const SeasonConfig& season, const Eigen::Vector2d& p,
+                              double clearance_m) {
+  for (const Structure& s : season.structures) {
+    if (s.blocks_robot && DistanceToStructure(s, p) <= clearance_m) return true;
+  }
+  return false;
+}
+
+bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d d = p - Eigen::Vector2d(goal.center_m.x, goal.center_m.y);
+  if (goal.shape == SolidShape::kCylinder) return d.norm() <= goal.radius_m;
+  const double yaw = goal.yaw_deg * kPi / 180.0;
+  const double lx = std::cos(yaw) * d.x() + std::sin(yaw) * d.y();
+  const double ly = -std::sin(yaw) * d.x() + std::cos(yaw) * d.y();
+  return std::abs(lx) <= goal.size_m.x / 2.0 && std::abs(ly) <= goal.size_m.y / 2.0;
+}
+
+bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double length_m,
+                     double width_m) {
+  const double c = std::cos(pose.theta_rad);
+  const double s = std::sin(pose.theta_rad);
+  // Sample the footprint's outline and centre line densely enough for the thinnest posts.
+  const double step = 0.02;
+  const double half = season.HalfSize();
+  const int nx = static_cast<int>(std::ceil(length_m / step));
+  const int ny = static_cast<int>(std::ceil(width_m / step));
+  for (int i = 0; i <= nx; ++i) {
+    for (int j = 0; j <= ny; ++j) {
+      if (i != 0 && i != nx && j != 0 && j != ny && j != ny / 2) continue;
+      const double lx = -length_m / 2.0 + length_m * i / nx;
+      const double ly = -width_m / 2.0 + width_m * j / ny;
+      const Eigen::Vector2d p(pose.x_m + c * lx - s * ly, pose.y_m + s * lx + c * ly);
+      if (std::abs(p.x()) > half || std::abs(p.y()) > half) return false;
+      for (const Structure& st : season.structures) {
+        if (st.blocks_robot && DistanceToStructure(st, p) <= 0.0) return false;
+      }
+    }
+  }
+  return true;
+}
+
+Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& l) {
+  if (l.shape != field::LandmarkShape::kDisc && l.shape != field::LandmarkShape::kSquare)
+    return Eigen::Vector3d(l.position_m.x, l.position_m.y, l.height_m);
+  // A plate: on the inner face of the nearest wall.
+  const double inset = season.HalfSize() - 0.005;
+  double x = l.position_m.x, y = l.position_m.y;
+  if (std::abs(l.position_m.x) >= std::abs(l.position_m.y)) {
+    x = std::clamp(x, -inset, inset);
+  } else {
+    y = std::clamp(y, -inset, inset);
+  }
+  return Eigen::Vector3d(x, y, l.height_m);
+}
+
+std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field) {
+  std::vector<Eigen::Vector2d> out;
+  for (const field::Landmark& l : field.landmarks)
+    out.push_back(LandmarkCentre(field, l).head<2>());
+  return out;
+}
+
+std::vector<int> MarkerIds(const field::SeasonConfig& field) {
+  std::vector<int> marker_id(field.landmarks.size(), -1);
+  for (size_t i = 0; i < field.landmarks.size(); ++i) {
+    const auto same = std::count_if(
+        field.landmarks.begin(), field.landmarks.end(),
+        [&](const field::Landmark& l) { return l.colour == field.landmarks[i].colour; });
+    if (same == 1) marker_id[i] = static_cast<int>(i);
+  }
+  return marker_id;
+}
+
+Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance, int start_index) {
+  const field::StartTile& start = StartFor(season, alliance, start_index);
+  return {start.center_m.x, start.center_m.y, start.heading_deg * kPi / 180.0};
+}
+
+}  // namespace slamo::platform

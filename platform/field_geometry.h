@@ -1,0 +1,45 @@
+// Pure geometry of the field as a season config describes it: where structures block robots,
+// what a goal's footprint holds, where the surveyed markers are and where the robot starts. No
+// simulator state: strategy, the match loop and the simulator all ask the same questions here.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "field_configs/season_config.h"
+#include "platform/drive_base.h"
+
+namespace slamo::platform {
+
+// Distance from point p to a structure's footprint in the plane (0 inside).
+double DistanceToStructure(const field::Structure& s, const Eigen::Vector2d& p);
+
+// True when a rectangle footprint at `pose` (length along the heading) is inside the
+// perimeter and clear of every structure that blocks robots.
+bool FootprintIsFree(const field::SeasonConfig& season, const Pose2D& pose, double length_m,
+                     double width_m);
+
+// True when the point lies on a structure that blocks robots (and objects).
+bool PointInBlockingStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p,
+                              double clearance_m);
+
+// True when the point lies inside a goal's footprint (box with yaw, or cylinder).
+bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p);
+
+// Where a landmark is drawn: discs and squares as plates on the inner face of the nearest wall
+// (centre 5 mm off it), cylinders and spheres where the season puts them.
+Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& landmark);
+
+// The surveyed perimeter markers' centres: where the renderer draws them (a plate's centre
+// sits just off its wall), which is where a team's tape measure puts them.
+std::vector<Eigen::Vector2d> SurveyedMarkers(const field::SeasonConfig& field);
+// Each marker's id in the filter: its index when no other marker shares its colour, else -1
+// (associated by position).
+std::vector<int> MarkerIds(const field::SeasonConfig& field);
+
+// The pose of the alliance's start_index-th starting tile (throws std::invalid_argument when
+// there is none).
+Pose2D StartPose(const field::SeasonConfig& season, field::Alliance alliance, int start_index);
+
+}  // namespace slamo::platform
