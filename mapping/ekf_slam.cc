@@ -7,10 +7,12 @@
 
 #include <Eigen/Dense>
 
+#include "platform/drive_base.h"
+
 namespace slamo::mapping {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 
 double Wrap(double a) {
   const double w = std::remainder(a, 2.0 * kPi);

@@ -7,10 +7,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "platform/drive_base.h"
+
 namespace slamo::planning {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 // LemLib's path generator puts the ghost point 20 inches past the end.
 constexpr double kGhostDistanceIn = 20.0;
 

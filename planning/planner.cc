@@ -22,13 +22,15 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "platform/drive_base.h"
+
 namespace slamo::planning {
 namespace {
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 
 double HeadingDeg(const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
   const Eigen::Vector2d d = to - from;

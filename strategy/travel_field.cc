@@ -6,9 +6,11 @@
 #include <queue>
 #include <utility>
 
+#include "platform/drive_base.h"
+
 namespace slamo::strategy {
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 }  // namespace
 

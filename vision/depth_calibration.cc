@@ -14,7 +14,7 @@
 namespace slamo::vision {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 
 // Plane through the points' centroid with the normal of least variance (SVD of the scatter
 // matrix): the least-squares plane in point-to-plane distance.

@@ -10,10 +10,12 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "platform/drive_base.h"
+
 namespace slamo::vision {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 // Below this a convexity defect is digitisation noise, whatever the blob's size.
 constexpr double kMinDefectDepthPx = 2.0;
 // approxPolyDP tolerance before convexityDefects: removes the staircase of the pixel contour.

@@ -12,7 +12,7 @@
 namespace slamo::mapping {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 
 class SlamOTest : public ::testing::Test {
  protected:

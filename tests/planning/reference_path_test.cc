@@ -6,11 +6,12 @@
 
 #include "field_configs/loader.h"
 #include "mapping/object_map.h"
+#include "platform/drive_base.h"
 
 namespace slamo::planning {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using platform::kPi;
 
 field::RobotConfig Robot() { return field::LoadRobotConfig("thesis_robot"); }
 

@@ -1,0 +1,72 @@
+// `slamo eval vision`: every detection and separation method scored against the simulator's
+// ground truth over many rendered views.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "autonomy/cli/commands.h"
+#include "autonomy/cli/options.h"
+#include "autonomy/experiments/vision_eval.h"
+#include "field_configs/loader.h"
+
+namespace slamo::autonomy {
+namespace {
+
+struct EvalArgs {
+  std::string season = field::kDefaultSeason;
+  std::string robot = field::kDefaultRobot;
+  int frames = 50;
+  uint64_t seed = 1;
+  std::string pictures;
+  std::string picture_method = "kmeans+defects";
+};
+
+int RunVision(const EvalArgs& args) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
+  const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  VisionEvalOptions options;
+  options.frames = args.frames;
+  options.seed = args.seed;
+  options.picture_dir = args.pictures;
+  options.picture_method = args.picture_method;
+  if (!args.pictures.empty()) std::filesystem::create_directories(args.pictures);
+  const auto progress = [](int done, int total) {
+    if (done % 10 == 0 || done == total) std::fprintf(stderr, "\rframe %d/%d", done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+  };
+  const std::vector<VisionMethodScore> scores = EvaluateVision(season, robot, options, progress);
+  std::printf(
+      "vision on %s: %d rendered views, seed %llu (objects with >= %d visible pixels are "
+      "expected)\n",
+      season.season.c_str(), args.frames, static_cast<unsigned long long>(args.seed),
+      options.min_visible_px);
+  std::fputs(FormatVisionTable(scores).c_str(), stdout);
+  return 0;
+}
+
+}  // namespace
+
+void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
+  auto args = std::make_shared<EvalArgs>();
+  CLI::App* eval = app.add_subcommand("eval",
+                                      "Score components against the simulator's ground truth.   "
+                                      "e.g. slamo eval vision --frames 50");
+  eval->require_subcommand(1);
+  CLI::App* vision = eval->add_subcommand(
+      "vision",
+      "Detection and separation methods on rendered views: precision, recall, errors.   "
+      "e.g. slamo eval vision --season toss_up --frames 100 --seed 1");
+  AddSeasonRobotOptions(vision, &args->season, &args->robot);
+  vision->add_option("--frames", args->frames, "rendered views")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  vision->add_option("--seed", args->seed, "random seed")->capture_default_str();
+  vision->add_option("--pictures", args->pictures,
+                     "write annotated views of the first 12 frames (detections, misses) here");
+  vision->add_option("--picture-method", args->picture_method, "method the pictures show")
+      ->capture_default_str();
+  vision->callback([action, args] { *action = [args] { return RunVision(*args); }; });
+}
+
+}  // namespace slamo::autonomy

@@ -1,0 +1,375 @@
+// `slamo experiment`: the thesis's SLAM experiments on the simulated field, averaged over
+// seeds and printed as tables.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "autonomy/cli/commands.h"
+#include "autonomy/cli/options.h"
+#include "autonomy/experiments/peer_bench.h"
+#include "autonomy/experiments/slam_experiments.h"
+#include "field_configs/loader.h"
+
+namespace slamo::autonomy {
+namespace {
+
+struct ExperimentArgs {
+  std::string season = field::kDefaultSeason;
+  std::string robot = field::kDefaultRobot;
+  int runs = 5;
+  uint64_t seed = 1;
+  std::string landmarks = "1,2,3";
+  std::string map = "slam,known";
+  std::string out;  // case study: where to write the first run's object map
+  std::string rules = "fixed:1,fixed:5,fixed:10,fixed:20,fixed:30,covariance,covariance:0.004,gmm";
+};
+
+std::vector<std::string> Split(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+// Measures the per-stop measurement bias the iterated filter must model: 10 frames a stop,
+// two landmarks, the same seeds as the experiment.
+Eigen::Matrix2d MeasureBias(const field::SeasonConfig& field, const field::RobotConfig& robot,
+                            const ExperimentArgs& args, Eigen::Vector2d* white) {
+  WaypointsSetup setup;
+  setup.landmarks = 2;
+  mapping::ParseFrameRule("fixed:10", &setup.frames);
+  std::vector<WaypointsRun> runs;
+  for (int r = 0; r < args.runs; ++r)
+    runs.push_back(RunWaypoints(field, robot, setup, args.seed + 1000 + r));
+  Eigen::Vector2d bias;
+  EstimateMeasurementNoise(runs, white, &bias);
+  return bias.asDiagonal();
+}
+
+int RunWaypointsTable(const ExperimentArgs& args) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
+  const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  std::vector<mapping::FrameSelectionOptions> rules;
+  for (const std::string& text : Split(args.rules)) {
+    mapping::FrameSelectionOptions options;
+    try {
+      mapping::ParseFrameRule(text, &options);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "error: --frames: " << e.what() << "\n";
+      return 2;
+    }
+    if (options.rule == mapping::FrameRule::kCovariance && options.covariance_threshold <= 0.0) {
+      options.covariance_threshold =
+          mapping::DerivedCovarianceThreshold(mapping::MotionNoise{}, 0.3);
+    }
+    rules.push_back(options);
+  }
+  std::vector<int> landmark_counts;
+  for (const std::string& n : Split(args.landmarks)) {
+    const int count = std::atoi(n.c_str());
+    if (count < 1 || count > 3) {
+      std::cerr << "error: --landmarks: expected counts 1, 2 or 3, got '" << n << "'\n";
+      return 2;
+    }
+    landmark_counts.push_back(count);
+  }
+
+  Eigen::Vector2d white;
+  const Eigen::Matrix2d bias = MeasureBias(WaypointsField(season, 2), robot, args, &white);
+  std::printf(
+      "measured per-frame noise (10 frames a stop, %d runs): range sd white %.4f m, per-stop bias "
+      "%.4f m;"
+      " bearing sd white %.5f rad, per-stop bias %.5f rad\n",
+      args.runs, std::sqrt(white.x()), std::sqrt(bias(0, 0)), std::sqrt(white.y()),
+      std::sqrt(bias(1, 1)));
+  std::printf("derived covariance threshold (one 0.3 m leg of motion noise): %.4f m^2\n\n",
+              mapping::DerivedCovarianceThreshold(mapping::MotionNoise{}, 0.3));
+  const auto band = mapping::NeesBand(3, args.runs);
+  std::printf(
+      "thesis 4.5: 4 stops every 0.3 m to 1.2 m, %d runs from seed %llu; NEES band (95 %%, %d "
+      "runs) "
+      "[%.2f, %.2f]\n",
+      args.runs, static_cast<unsigned long long>(args.seed), args.runs, band.first, band.second);
+  std::vector<bool> map_modes;
+  for (const std::string& m : Split(args.map)) {
+    if (m != "slam" && m != "known") {
+      std::cerr << "error: --map: expected slam and/or known, got '" << m << "'\n";
+      return 2;
+    }
+    map_modes.push_back(m == "known");
+  }
+  std::printf("%-6s %-10s %-19s %10s %10s %8s %9s %11s %9s\n", "map", "landmarks", "frames",
+              "acc_err_m", "odom_err_m", "frames", "observe_s", "compute_ms", "nees");
+  int done = 0;
+  const int total =
+      static_cast<int>(map_modes.size() * landmark_counts.size() * rules.size()) * args.runs;
+  for (const bool known : map_modes) {
+    for (int landmarks : landmark_counts) {
+      const field::SeasonConfig field = WaypointsField(season, landmarks);
+      for (const mapping::FrameSelectionOptions& rule : rules) {
+        WaypointsSetup setup;
+        setup.landmarks = landmarks;
+        setup.frames = rule;
+        setup.bias_covariance = bias;
+        setup.white_covariance = white.asDiagonal();  // the measured per-frame noise
+        setup.known_landmarks = known;
+        double error = 0, odom = 0, frames = 0, compute = 0, nees = 0;
+        int nees_n = 0;
+        for (int r = 0; r < args.runs; ++r) {
+          const WaypointsRun run = RunWaypoints(field, robot, setup, args.seed + r);
+          error += run.AccumulatedError() / args.runs;
+          odom += run.OdometryAccumulatedError() / args.runs;
+          frames += static_cast<double>(run.frames) / args.runs;
+          compute += run.compute_s / args.runs;
+          for (double n : run.stop_nees) nees += n, ++nees_n;
+          std::fprintf(stderr, "\rrun %d/%d", ++done, total);
+        }
+        std::fprintf(stderr, "\r");
+        std::printf("%-6s %-10d %-19s %10.4f %10.4f %8.1f %9.2f %11.2f %9.2f\n",
+                    known ? "known" : "slam", landmarks, mapping::Describe(rule).c_str(), error,
+                    odom, frames, frames / robot.camera.frame_rate_hz,
+                    1000.0 * compute / std::max(1.0, frames), nees_n ? nees / nees_n : 0.0);
+      }
+    }
+  }
+  std::printf(
+      "\nacc_err_m: sum over the 4 stops of the position error (thesis Table 4-1); odom_err_m: the "
+      "same"
+      " for encoder dead reckoning; frames: in total; observe_s: frames at %.0f fps; compute_ms: "
+      "detection"
+      " and filter per frame on this machine; nees: mean pose NEES at the stops.\n",
+      robot.camera.frame_rate_hz);
+  return 0;
+}
+
+int RunNeesTable(const ExperimentArgs& args) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
+  const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  Eigen::Vector2d white;
+  const Eigen::Matrix2d bias = MeasureBias(WaypointsField(season, 2), robot, args, &white);
+  const auto band = mapping::NeesBand(3, args.runs);
+  std::printf(
+      "pose NEES at each stop, averaged over %d runs (seed %llu); 95 %% band [%.2f, %.2f]\n",
+      args.runs, static_cast<unsigned long long>(args.seed), band.first, band.second);
+  std::printf("%-6s %-34s %8s %8s %8s %8s %8s\n", "map", "mode", "stop 1", "stop 2", "stop 3",
+              "stop 4", "inside");
+  for (const bool known : {false, true}) {
+    for (int mode = 0; mode < 3; ++mode) {
+      WaypointsSetup setup;
+      setup.landmarks = 2;
+      setup.known_landmarks = known;
+      mapping::ParseFrameRule("fixed:10", &setup.frames);
+      setup.iterate = mode != 0;
+      // The measured per-frame noise; the per-stop bias modelled only in the last mode (and in
+      // the single-frame mode, where one frame carries both).
+      setup.white_covariance = white.asDiagonal();
+      if (mode == 0) setup.white_covariance += bias;
+      if (mode == 2) setup.bias_covariance = bias;
+      std::vector<double> average(setup.stops, 0.0);
+      for (int r = 0; r < args.runs; ++r) {
+        const WaypointsRun run =
+            RunWaypoints(WaypointsField(season, 2), robot, setup, args.seed + r);
+        for (size_t s = 0; s < run.stop_nees.size(); ++s)
+          average[s] += run.stop_nees[s] / args.runs;
+      }
+      int inside = 0;
+      for (double a : average) inside += a >= band.first && a <= band.second;
+      const char* name = mode == 0   ? "single frame"
+                         : mode == 1 ? "10 frames, frames independent"
+                                     : "10 frames, per-stop bias modelled";
+      std::printf("%-6s %-34s %8.2f %8.2f %8.2f %8.2f %6d/%d\n", known ? "known" : "slam", name,
+                  average[0], average[1], average[2], average[3], inside, setup.stops);
+    }
+  }
+  return 0;
+}
+
+int RunCaseStudy(const ExperimentArgs& args, int study) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
+  const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  // Thesis ch. 6 on the field: (1) a 1.5 m diagonal, stopping every 0.3 m; (2) 1.2 m forward,
+  // a 90 degree left turn, 0.6 m. 20 frames a stop, the season's surveyed markers.
+  // Starts with room to drive: clear of the hanging-bar posts and the goals.
+  const platform::Pose2D start =
+      study == 1 ? platform::Pose2D{-1.45, -0.45, 0.61} : platform::Pose2D{-1.524, -0.3048, 0.0};
+  std::vector<std::string> legs;
+  if (study == 1) {
+    legs.assign(5, "forward 0.3");
+  } else {
+    legs.assign(4, "forward 0.3");
+    legs.push_back("turn 90");
+    legs.push_back("forward 0.3");
+    legs.push_back("forward 0.3");
+  }
+  if (!args.out.empty()) std::filesystem::create_directories(args.out);
+  WaypointsSetup setup;
+  mapping::ParseFrameRule(args.rules.find(',') == std::string::npos ? args.rules : "fixed:20",
+                          &setup.frames);
+  setup.known_landmarks = args.map != "slam";
+  std::printf("case study %d on %s: %s, frames %s, %s markers, %d runs from seed %llu\n", study,
+              season.season.c_str(),
+              study == 1 ? "1.5 m diagonal, stops every 0.3 m" : "1.2 m, turn left 90, 0.6 m",
+              mapping::Describe(setup.frames).c_str(),
+              setup.known_landmarks ? "surveyed" : "unknown (SLAM)", args.runs,
+              static_cast<unsigned long long>(args.seed));
+  std::vector<double> pose_error(legs.size(), 0.0), odometry_error(legs.size(), 0.0);
+  double within3_sq = 0.0, all_sq = 0.0;
+  int within3 = 0, matched = 0, tracked = 0, moved = 0, unconfirmed = 0;
+  for (int r = 0; r < args.runs; ++r) {
+    setup.map_out_dir = r == 0 ? args.out : "";
+    const WaypointsRun run = RunRoute(season, robot, start, legs, setup, args.seed + r, true);
+    for (size_t s = 0; s < legs.size(); ++s) {
+      pose_error[s] += run.stop_error_m[s] / args.runs;
+      odometry_error[s] += run.odometry_error_m[s] / args.runs;
+    }
+    for (const WaypointsRun::ObjectResult& o : run.objects) {
+      if (!o.confirmed) {
+        ++unconfirmed;  // seen once: not yet part of the map
+        continue;
+      }
+      ++tracked;
+      if (!o.matched) continue;
+      ++matched;
+      if (o.truth_moved) {
+        ++moved;  // pushed by the robot after it was seen: not a mapping error
+        continue;
+      }
+      all_sq += o.error_m * o.error_m;
+      if (o.first_range_m <= 3.0) within3_sq += o.error_m * o.error_m, ++within3;
+    }
+    std::fprintf(stderr, "\rrun %d/%d", r + 1, args.runs);
+  }
+  std::fprintf(stderr, "\r");
+  std::printf("%-6s %-12s %12s %12s\n", "stop", "leg", "slam_err_m", "odom_err_m");
+  for (size_t s = 0; s < legs.size(); ++s) {
+    std::printf("%-6zu %-12s %12.4f %12.4f\n", s + 1, legs[s].c_str(), pose_error[s],
+                odometry_error[s]);
+  }
+  const int unmoved = matched - moved;
+  std::printf(
+      "objects: %d confirmed (seen at two stops or more; %d seen once are not mapped yet), ",
+      tracked, unconfirmed);
+  std::printf(
+      "%d matched to a true object within 0.5 m (%d of those pushed by the robot afterwards, "
+      "not scored); RMSE %.3f m over %d, %.3f m over the %d first seen within 3 m\n",
+      matched, moved, unmoved ? std::sqrt(all_sq / unmoved) : 0.0, unmoved,
+      within3 ? std::sqrt(within3_sq / within3) : 0.0, within3);
+  return 0;
+}
+
+int RunPeerTable(const ExperimentArgs& args) {
+  const PeerBenchOptions options;
+  const PeerBenchResult result = RunPeerBench(options, args.runs, args.seed);
+  std::printf(
+      "peer comparison: %d laps of a %.1f m square in %.2f m steps, %d landmarks, range <= %.1f m"
+      " (sd %.3f m, %.2f deg), odometry sd %.3f m, %.3f rad a step, ids known; %d runs from seed "
+      "%llu\n",
+      options.laps, options.side_m, options.step_m, options.landmarks, options.max_range_m,
+      options.sigma_range_m, options.sigma_bearing_rad * 180.0 / 3.14159265358979323846,
+      options.sigma_step_xy_m, options.sigma_step_heading_rad, args.runs,
+      static_cast<unsigned long long>(args.seed));
+  std::printf("%-28s %14s %16s %14s %9s %11s\n", "filter", "ATE_aligned_m", "ATE_unaligned_m",
+              "mean_NEES", "in_band", "ms_per_step");
+  for (const PeerRow& row : result.rows) {
+    std::printf("%-28s %14.4f %16.4f %14.2f %5d/%-3d %11.4f\n", row.filter.c_str(),
+                row.ate_aligned_m, row.ate_unaligned_m, row.mean_nees, row.steps_in_band, row.steps,
+                row.ms_per_step);
+  }
+  std::printf(
+      "\nATE: mean over runs of the trajectory RMSE, after rigid alignment and without; "
+      "mean_NEES: pose NEES averaged over the runs at each step, then over steps 1-%d; in_band: "
+      "steps whose run average lies in the 95 %% band [%.2f, %.2f]; ms_per_step: inside the "
+      "filter's step call only, on this machine.\n",
+      result.rows.empty() ? 0 : result.rows.front().steps, result.nees_band.first,
+      result.nees_band.second);
+  for (const PeerRow& row : result.rows) {
+    if (row.rejected > 0) {
+      std::printf("note: %s refused %d measurements\n", row.filter.c_str(), row.rejected);
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+void RegisterExperimentCommand(CLI::App& app, CommandAction* action) {
+  auto args = std::make_shared<ExperimentArgs>();
+  CLI::App* experiment = app.add_subcommand("experiment",
+                                            "The thesis's SLAM experiments on the simulator, as "
+                                            "tables.   e.g. slamo experiment waypoints");
+  experiment->require_subcommand(1);
+  CLI::App* waypoints = experiment->add_subcommand(
+      "waypoints",
+      "Thesis 4.5: stops every 0.3 m to 1.2 m, 1-3 landmarks, each frame rule.   "
+      "e.g. slamo experiment waypoints --runs 10");
+  AddSeasonRobotOptions(waypoints, &args->season, &args->robot);
+  waypoints->add_option("--runs", args->runs, "seeds averaged per row")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  waypoints->add_option("--seed", args->seed, "first seed")->capture_default_str();
+  waypoints->add_option("--landmarks", args->landmarks, "landmark counts, comma separated")
+      ->capture_default_str();
+  waypoints->add_option("--map", args->map, "slam (markers found) and/or known (surveyed markers)")
+      ->capture_default_str();
+  waypoints
+      ->add_option("--frames", args->rules,
+                   "frame rules: fixed:N, covariance[:T], gmm; comma separated")
+      ->capture_default_str();
+  waypoints->callback([action, args] { *action = [args] { return RunWaypointsTable(*args); }; });
+
+  CLI::App* nees = experiment->add_subcommand(
+      "nees",
+      "Pose NEES per stop over many runs, single-frame and iterated, against the 95 % band.   "
+      "e.g. slamo experiment nees --runs 50");
+  AddSeasonRobotOptions(nees, &args->season, &args->robot);
+  nees->add_option("--runs", args->runs, "Monte Carlo runs")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  nees->add_option("--seed", args->seed, "first seed")->capture_default_str();
+  nees->callback([action, args] { *action = [args] { return RunNeesTable(*args); }; });
+
+  auto study = std::make_shared<int>(1);
+  CLI::App* case_study = experiment->add_subcommand(
+      "case-study",
+      "Thesis ch. 6 on the field: pose error per stop and object errors.   "
+      "e.g. slamo experiment case-study 1 --runs 5");
+  case_study->add_option("study", *study, "1: 1.5 m diagonal; 2: 1.2 m, turn left 90, 0.6 m")
+      ->required()
+      ->check(CLI::Range(1, 2));
+  AddSeasonRobotOptions(case_study, &args->season, &args->robot);
+  case_study->add_option("--runs", args->runs, "seeds averaged")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  case_study->add_option("--seed", args->seed, "first seed")->capture_default_str();
+  case_study->add_option("--map", args->map, "known (surveyed markers) or slam")
+      ->capture_default_str();
+  case_study->add_option("--frames", args->rules,
+                         "one frame rule (default fixed:20 as the thesis)");
+  case_study->add_option("--out", args->out,
+                         "write the first run's OctoMap (objects.bt, objects.ot) here");
+  case_study->callback(
+      [action, args, study] { *action = [args, study] { return RunCaseStudy(*args, *study); }; });
+
+  CLI::App* peer = experiment->add_subcommand(
+      "peer",
+      "MRPT's CRangeBearingKFSLAM2D and slamo's EKF on the same simulated laps: ATE, NEES, time.   "
+      "e.g. slamo experiment peer --runs 20");
+  auto peer_runs = std::make_shared<int>(20);
+  peer->add_option("--runs", *peer_runs, "Monte Carlo runs (seeds)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  peer->add_option("--seed", args->seed, "first seed")->capture_default_str();
+  peer->callback([action, args, peer_runs] {
+    *action = [args, peer_runs] {
+      ExperimentArgs peer_args = *args;
+      peer_args.runs = *peer_runs;
+      return RunPeerTable(peer_args);
+    };
+  });
+}
+
+}  // namespace slamo::autonomy

@@ -1,0 +1,380 @@
+#include "autonomy/experiments/tuning.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "autonomy/io/sim_io.h"
+#include "autonomy/loop/executive.h"
+#include "planning/planner.h"
+#include "strategy/strategy.h"
+
+namespace slamo::autonomy {
+namespace {
+
+double ToDouble(const std::string& name, const std::string& value) {
+  try {
+    size_t used = 0;
+    const double v = std::stod(value, &used);
+    if (used == value.size() && std::isfinite(v)) return v;
+  } catch (const std::exception&) {
+  }
+  throw std::invalid_argument("--param " + name + ": expected a number, got \"" + value + "\"");
+}
+
+int ToInt(const std::string& name, const std::string& value) {
+  const double v = ToDouble(name, value);
+  if (v != std::floor(v))
+    throw std::invalid_argument("--param " + name + ": expected a whole number, got \"" + value +
+                                "\"");
+  return static_cast<int>(v);
+}
+
+}  // namespace
+
+const std::map<std::string, std::string>& TunableParams() {
+  static const std::map<std::string, std::string> params = {
+      {"strategy", "planner | greedy | scripted | thesis"},
+      {"frames", "frame rule: fixed:N | covariance | gmm"},
+      {"speed", "driving speed, m/s (0: the robot's match_speed_mps)"},
+      {"jitter", "object placement jitter, m"},
+      {"horizon", "planner: pick-and-score cycles searched ahead"},
+      {"min_gain", "planner: expected points below which a cycle is not worth it"},
+      {"look_frames", "frames of an exploratory look"},
+      {"pick_tolerance", "lateral error the intake forgives, m"},
+      {"approach_margin", "staging distance before the final approach, m"},
+      {"check_spacing", "m of path between quick looks while driving (0: none)"},
+      {"correction_frames", "frames of a quick look"},
+      {"arrival_fixes", "look-and-correct rounds on arrival"},
+      {"pushable", "objects narrower than this fraction of the robot are pushed, not avoided"},
+      {"arrival_frames", "planner: frames to check an arrival"},
+      {"observe_first", "planner: 1 weighs observing before a cycle (frames 5, 10, 20); 0 never"},
+      {"gyro", "1: a yaw gyro's heading into SLAM-O; 0: encoders and camera only"},
+      {"planner", "OMPL planner: rrtconnect | rrtstar | informedrrtstar | prmstar | bitstar"},
+  };
+  return params;
+}
+
+void ApplyParam(const std::string& name, const std::string& value, MatchSetup* setup) {
+  if (name == "strategy") {
+    strategy::MakeStrategy(value, setup->strategy_options);  // throws on an unknown name
+    setup->strategy = value;
+  } else if (name == "frames") {
+    mapping::ParseFrameRule(value, &setup->frames);
+  } else if (name == "speed") {
+    setup->drive_speed_mps = ToDouble(name, value);
+  } else if (name == "jitter") {
+    setup->placement_jitter_m = ToDouble(name, value);
+  } else if (name == "horizon") {
+    setup->strategy_options.horizon = ToInt(name, value);
+  } else if (name == "min_gain") {
+    setup->strategy_options.min_gain = ToDouble(name, value);
+  } else if (name == "look_frames") {
+    setup->strategy_options.look_frames = ToInt(name, value);
+  } else if (name == "pick_tolerance") {
+    setup->strategy_options.pick_tolerance_m = ToDouble(name, value);
+  } else if (name == "approach_margin") {
+    setup->strategy_options.approach_margin_m = ToDouble(name, value);
+  } else if (name == "check_spacing") {
+    setup->check_spacing_m = ToDouble(name, value);
+  } else if (name == "correction_frames") {
+    setup->correction_frames = ToInt(name, value);
+  } else if (name == "arrival_fixes") {
+    setup->arrival_fixes = ToInt(name, value);
+  } else if (name == "pushable") {
+    setup->pushable_fraction = ToDouble(name, value);
+  } else if (name == "arrival_frames") {
+    setup->strategy_options.arrival_frames = ToInt(name, value);
+  } else if (name == "observe_first") {
+    if (value != "0" && value != "1")
+      throw std::invalid_argument("--param observe_first: expected 0 or 1");
+    setup->strategy_options.frame_choices =
+        value == "1" ? std::vector<int>{0, 5, 10, 20} : std::vector<int>{0};
+  } else if (name == "gyro") {
+    if (value != "0" && value != "1")
+      throw std::invalid_argument("--param gyro: expected 0 or 1, got \"" + value + "\"");
+    setup->gyro = value == "1";
+  } else if (name == "planner") {
+    const auto& names = planning::PlannerNames();
+    if (std::find(names.begin(), names.end(), value) == names.end()) {
+      throw std::invalid_argument("--param planner: unknown planner \"" + value + "\"");
+    }
+    setup->planner = value;
+  } else {
+    std::string known;
+    for (const auto& [n, _] : TunableParams()) known += (known.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("--param: unknown parameter \"" + name + "\" (known: " + known +
+                                ")");
+  }
+}
+
+std::pair<std::string, std::vector<std::string>> ParseParam(const std::string& text) {
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
+    throw std::invalid_argument("--param: expected name=v1,v2,..., got \"" + text + "\"");
+  }
+  std::pair<std::string, std::vector<std::string>> out{text.substr(0, eq), {}};
+  std::stringstream values(text.substr(eq + 1));
+  std::string v;
+  while (std::getline(values, v, ',')) {
+    if (v.empty()) throw std::invalid_argument("--param " + out.first + ": an empty value");
+    out.second.push_back(v);
+  }
+  MatchSetup check;
+  for (const std::string& value : out.second) ApplyParam(out.first, value, &check);
+  return out;
+}
+
+std::vector<ParamSet> Combinations(const ParamGrid& grid) {
+  std::vector<ParamSet> out = {{}};
+  for (const auto& [name, values] : grid) {
+    std::vector<ParamSet> next;
+    for (const ParamSet& base : out) {
+      for (const std::string& v : values) {
+        ParamSet p = base;
+        p.emplace_back(name, v);
+        next.push_back(p);
+      }
+    }
+    out = next;
+  }
+  return out;
+}
+
+std::string Describe(const ParamSet& params) {
+  if (params.empty()) return "(defaults)";
+  std::string out;
+  for (const auto& [name, value] : params) out += (out.empty() ? "" : " ") + name + "=" + value;
+  return out;
+}
+
+nlohmann::json ToJson(const MatchOutcome& o) {
+  return {{"combo", o.combo},
+          {"seed", o.seed},
+          {"points", o.points},
+          {"points_start", o.points_start},
+          {"overrun_s", o.overrun_s},
+          {"refused", o.refused},
+          {"pose_ate_m", o.pose_ate_m},
+          {"duration_s", o.duration_s},
+          {"wall_s", o.wall_s},
+          {"failed", o.failed},
+          {"error", o.error}};
+}
+
+MatchOutcome OutcomeFromJson(const nlohmann::json& j) {
+  MatchOutcome o;
+  o.combo = j.at("combo").get<std::string>();
+  o.seed = j.at("seed").get<uint64_t>();
+  o.points = j.at("points").get<int>();
+  o.points_start = j.at("points_start").get<int>();
+  o.overrun_s = j.at("overrun_s").get<double>();
+  o.refused = j.at("refused").get<int>();
+  o.pose_ate_m = j.at("pose_ate_m").get<double>();
+  o.duration_s = j.at("duration_s").get<double>();
+  o.wall_s = j.at("wall_s").get<double>();
+  o.failed = j.at("failed").get<bool>();
+  o.error = j.value("error", "");
+  return o;
+}
+
+std::vector<MatchOutcome> RunTasks(const field::SeasonConfig& season,
+                                   const field::RobotConfig& robot,
+                                   const std::vector<ParamSet>& combos,
+                                   const std::vector<TuneTask>& tasks, int jobs,
+                                   const std::function<void(size_t, size_t)>& progress) {
+  std::vector<MatchOutcome> out(tasks.size());
+  struct Child {
+    pid_t pid;
+    int fd;
+    size_t task;
+  };
+  std::vector<Child> running;
+  size_t next = 0, done = 0;
+  const auto launch = [&](size_t t) {
+    int fds[2];
+    if (pipe(fds) != 0) throw std::runtime_error("tune: cannot create a pipe");
+    const pid_t pid = fork();
+    if (pid < 0) throw std::runtime_error("tune: cannot fork");
+    if (pid == 0) {
+      // The match, alone in this process; its outcome goes back as one JSON line.
+      close(fds[0]);
+      MatchOutcome o;
+      o.combo = Describe(combos[tasks[t].combo_index]);
+      o.seed = tasks[t].seed;
+      try {
+        MatchSetup setup;
+        setup.snapshot_period_s = 0.0;
+        for (const auto& [name, value] : combos[tasks[t].combo_index])
+          ApplyParam(name, value, &setup);
+        const MatchResult r = RunMatch(season, robot, setup, tasks[t].seed);
+        o.points = r.points;
+        o.points_start = r.points_start;
+        o.overrun_s = r.overrun_s;
+        o.refused = r.refused;
+        o.pose_ate_m = r.pose_ate_m;
+        o.duration_s = r.duration_s;
+        o.wall_s = r.wall_s;
+      } catch (const std::exception& e) {
+        o.failed = true;
+        o.error = e.what();
+      }
+      const std::string line = ToJson(o).dump() + "\n";
+      size_t written = 0;
+      while (written < line.size()) {
+        const ssize_t n = write(fds[1], line.data() + written, line.size() - written);
+        if (n <= 0) break;
+        written += static_cast<size_t>(n);
+      }
+      close(fds[1]);
+      _exit(0);
+    }
+    close(fds[1]);
+    running.push_back({pid, fds[0], t});
+  };
+  while (done < tasks.size()) {
+    while (static_cast<int>(running.size()) < std::max(1, jobs) && next < tasks.size())
+      launch(next++);
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) throw std::runtime_error("tune: waitpid failed");
+    const auto it = std::find_if(running.begin(), running.end(),
+                                 [pid](const Child& c) { return c.pid == pid; });
+    if (it == running.end()) continue;
+    std::string text;
+    char buffer[4096];
+    for (ssize_t n; (n = read(it->fd, buffer, sizeof(buffer))) > 0;)
+      text.append(buffer, static_cast<size_t>(n));
+    close(it->fd);
+    MatchOutcome o;
+    try {
+      o = OutcomeFromJson(nlohmann::json::parse(text));
+    } catch (const std::exception&) {
+      o.combo = Describe(combos[tasks[it->task].combo_index]);
+      o.seed = tasks[it->task].seed;
+      o.failed = true;
+      o.error = WIFSIGNALED(status)
+                    ? "the match process died of signal " + std::to_string(WTERMSIG(status))
+                    : "the match process exited with status " + std::to_string(WEXITSTATUS(status));
+    }
+    out[it->task] = o;
+    running.erase(it);
+    ++done;
+    if (progress) progress(done, tasks.size());
+  }
+  return out;
+}
+
+std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<const MatchOutcome*>> by_combo;
+  for (const MatchOutcome& o : outcomes) {
+    if (!by_combo.count(o.combo)) order.push_back(o.combo);
+    by_combo[o.combo].push_back(&o);
+  }
+  std::vector<ComboSummary> rows;
+  for (const std::string& combo : order) {
+    ComboSummary s;
+    s.combo = combo;
+    std::vector<double> points, gained;
+    for (const MatchOutcome* o : by_combo[combo]) {
+      if (o->failed) {
+        ++s.failed;
+        continue;
+      }
+      ++s.matches;
+      points.push_back(o->points);
+      gained.push_back(o->points - o->points_start);
+      if (o->overrun_s > 0.0) ++s.overruns;
+      s.mean_overrun_s += o->overrun_s;
+      s.mean_ate_m += o->pose_ate_m;
+      s.mean_wall_s += o->wall_s;
+    }
+    const auto mean_ci = [](const std::vector<double>& v, double* mean, double* ci) {
+      *mean = *ci = 0.0;
+      if (v.empty()) return;
+      for (double x : v) *mean += x;
+      *mean /= v.size();
+      if (v.size() < 2) return;
+      double ss = 0.0;
+      for (double x : v) ss += (x - *mean) * (x - *mean);
+      *ci = 1.96 * std::sqrt(ss / (v.size() - 1)) / std::sqrt(static_cast<double>(v.size()));
+    };
+    mean_ci(points, &s.mean_points, &s.ci95_points);
+    mean_ci(gained, &s.mean_gained, &s.ci95_gained);
+    if (s.matches > 0) {
+      s.mean_overrun_s /= s.matches;
+      s.mean_ate_m /= s.matches;
+      s.mean_wall_s /= s.matches;
+    }
+    rows.push_back(s);
+  }
+  std::stable_sort(rows.begin(), rows.end(), [](const ComboSummary& a, const ComboSummary& b) {
+    return a.mean_points > b.mean_points;
+  });
+  return rows;
+}
+
+std::string SummaryCsv(const std::vector<ComboSummary>& rows) {
+  std::ostringstream out;
+  out << "rank,combo,matches,failed,mean_points,ci95_points,mean_gained,ci95_gained,overruns,mean_"
+         "overrun_s,"
+         "mean_ate_m,mean_wall_s\n";
+  int rank = 0;
+  for (const ComboSummary& r : rows) {
+    out << ++rank << ",\"" << r.combo << "\"," << r.matches << ',' << r.failed << ','
+        << r.mean_points << ',' << r.ci95_points << ',' << r.mean_gained << ',' << r.ci95_gained
+        << ',' << r.overruns << ',' << r.mean_overrun_s << ',' << r.mean_ate_m << ','
+        << r.mean_wall_s << '\n';
+  }
+  return out.str();
+}
+
+nlohmann::json SummaryJson(const std::vector<ComboSummary>& rows,
+                           const std::vector<MatchOutcome>& outcomes) {
+  nlohmann::json j;
+  j["ranking"] = nlohmann::json::array();
+  for (const ComboSummary& r : rows) {
+    j["ranking"].push_back({{"combo", r.combo},
+                            {"matches", r.matches},
+                            {"failed", r.failed},
+                            {"mean_points", r.mean_points},
+                            {"ci95_points", r.ci95_points},
+                            {"mean_gained", r.mean_gained},
+                            {"ci95_gained", r.ci95_gained},
+                            {"overruns", r.overruns},
+                            {"mean_overrun_s", r.mean_overrun_s},
+                            {"mean_ate_m", r.mean_ate_m},
+                            {"mean_wall_s", r.mean_wall_s}});
+  }
+  j["matches"] = nlohmann::json::array();
+  for (const MatchOutcome& o : outcomes) j["matches"].push_back(ToJson(o));
+  return j;
+}
+
+void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out) {
+  out << std::left << std::setw(5) << "rank" << std::setw(40) << "parameters" << std::right
+      << std::setw(8) << "matches" << std::setw(18) << "points (95% CI)" << std::setw(18)
+      << "gained (95% CI)" << std::setw(10) << "overruns" << std::setw(10) << "ATE m"
+      << std::setw(10) << "wall s"
+      << "\n";
+  int rank = 0;
+  for (const ComboSummary& r : rows) {
+    std::ostringstream points, gained;
+    points << std::fixed << std::setprecision(2) << r.mean_points << " +- " << r.ci95_points;
+    gained << std::fixed << std::setprecision(2) << r.mean_gained << " +- " << r.ci95_gained;
+    out << std::left << std::setw(5) << ++rank << std::setw(40) << r.combo << std::right
+        << std::setw(8) << r.matches << std::setw(18) << points.str() << std::setw(18)
+        << gained.str() << std::setw(10) << r.overruns << std::setw(10) << std::fixed
+        << std::setprecision(3) << r.mean_ate_m << std::setw(10) << std::setprecision(2)
+        << r.mean_wall_s << "\n";
+    if (r.failed) out << "     (" << r.failed << " matches failed: see tune.json)\n";
+  }
+}
+
+}  // namespace slamo::autonomy

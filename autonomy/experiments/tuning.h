@@ -1,0 +1,83 @@
+// Many simulated matches: every combination of parameter values times N seeds, run in
+// separate processes (OMPL's random numbers are per process, so each match gets a fresh one
+// and stays repeatable), summarised per combination with a confidence interval.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "autonomy/loop/match_world.h"
+#include "field_configs/robot_config.h"
+#include "field_configs/season_config.h"
+
+namespace slamo::autonomy {
+
+// A parameter sweep: name -> the values to try ("strategy" -> {"planner", "greedy"}).
+using ParamGrid = std::vector<std::pair<std::string, std::vector<std::string>>>;
+using ParamSet = std::vector<std::pair<std::string, std::string>>;
+
+// The names --param accepts, with what they set.
+const std::map<std::string, std::string>& TunableParams();
+// Applies name=value to a setup; throws std::invalid_argument on an unknown name or value.
+void ApplyParam(const std::string& name, const std::string& value, MatchSetup* setup);
+// "name=v1,v2,..." -> (name, values); throws std::invalid_argument.
+std::pair<std::string, std::vector<std::string>> ParseParam(const std::string& text);
+// Every combination, in a fixed order.
+std::vector<ParamSet> Combinations(const ParamGrid& grid);
+std::string Describe(const ParamSet& params);
+
+// One match's outcome, as a tuning run keeps it.
+struct MatchOutcome {
+  std::string combo;
+  uint64_t seed = 0;
+  int points = 0;
+  int points_start = 0;
+  double overrun_s = 0.0;
+  int refused = 0;
+  double pose_ate_m = 0.0;
+  double duration_s = 0.0;
+  double wall_s = 0.0;
+  bool failed = false;  // the match process crashed or threw
+  std::string error;
+};
+nlohmann::json ToJson(const MatchOutcome& o);
+MatchOutcome OutcomeFromJson(const nlohmann::json& j);
+
+struct TuneTask {
+  size_t combo_index = 0;
+  uint64_t seed = 0;
+};
+
+// Runs the tasks on `jobs` processes; `progress(done, total)` after each.
+std::vector<MatchOutcome> RunTasks(const field::SeasonConfig& season,
+                                   const field::RobotConfig& robot,
+                                   const std::vector<ParamSet>& combos,
+                                   const std::vector<TuneTask>& tasks, int jobs,
+                                   const std::function<void(size_t, size_t)>& progress);
+
+struct ComboSummary {
+  std::string combo;
+  int matches = 0;
+  int failed = 0;
+  double mean_points = 0.0;
+  double ci95_points = 0.0;  // half-width of the 95 % confidence interval of the mean
+  double mean_gained = 0.0;
+  double ci95_gained = 0.0;
+  int overruns = 0;  // matches with motors driven after the deadline
+  double mean_overrun_s = 0.0;
+  double mean_ate_m = 0.0;
+  double mean_wall_s = 0.0;
+};
+// Per combination, ranked by mean points (best first).
+std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes);
+std::string SummaryCsv(const std::vector<ComboSummary>& rows);
+nlohmann::json SummaryJson(const std::vector<ComboSummary>& rows,
+                           const std::vector<MatchOutcome>& outcomes);
+void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out);
+
+}  // namespace slamo::autonomy

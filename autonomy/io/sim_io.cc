@@ -1,0 +1,163 @@
+#include "autonomy/io/sim_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "platform/field_geometry.h"
+
+#include "platform/sim/sim_drive_script.h"
+#include "platform/sim/sim_field.h"
+#include "platform/sim/sim_gyro.h"
+#include "platform/sim/sim_renderer.h"
+
+namespace slamo::autonomy {
+namespace {
+
+using platform::Pose2D;
+
+// What a team measures before it trusts its encoders: drive 1 m straight a few times on an
+// empty floor and compare the true distance (a tape measure) with what the encoders say. The
+// mean ratio scales every commanded distance and every odometry increment; SLAM-O is left the
+// random part of the slip.
+double CalibrateOdometryScale(const field::RobotConfig& robot) {
+  double ratio = 0.0;
+  const int runs = 5;
+  for (int i = 0; i < runs; ++i) {
+    const std::vector<platform::DriveStepResult> r =
+        platform::SimulateDriveScript("forward 1.0", robot, platform::SimDriveOptions{}, 1000 + i);
+    const double truth = std::hypot(r.back().true_pose.x_m, r.back().true_pose.y_m);
+    const double encoders = std::hypot(r.back().odometry_pose.x_m, r.back().odometry_pose.y_m);
+    ratio += truth / encoders;
+  }
+  return ratio / runs;
+}
+
+class SimIo : public RobotIo {
+ public:
+  SimIo(field::Alliance alliance, uint64_t seed) : alliance_(alliance), seed_(seed), gyro_(seed) {}
+
+  void Start(const field::SeasonConfig& field, const field::RobotConfig& robot,
+             const Pose2D& start) override {
+    robot_ = robot;
+    platform::SimFieldOptions options;
+    options.preload = true;
+    sim_ = std::make_unique<platform::SimField>(field, robot, alliance_, seed_, start,
+                                                platform::SimDriveOptions{}, options);
+    renderer_ = std::make_unique<platform::SimRenderer>(field, robot.camera,
+                                                        platform::RenderOptions{}, seed_);
+  }
+  const platform::Clock& clock() const override { return clock_; }
+  platform::DriveBase& drive() override { return sim_->drive(); }
+  void Advance(double dt_s) override {
+    sim_->Step(dt_s);
+    clock_.Advance(dt_s);
+  }
+  Pose2D OdometryPose() const override { return sim_->drive().odometry_pose(); }
+  bool MotorsDriven() const override {
+    const platform::SimDriveBase& d = sim_->drive();
+    return d.left_pwm() != robot_.drive.pwm.stop || d.right_pwm() != robot_.drive.pwm.stop;
+  }
+  std::optional<double> GyroHeadingRad() override {
+    return gyro_.Read(sim_->robot_pose().theta_rad, clock_.NowS());
+  }
+  std::optional<platform::RgbdFrame> Capture() override {
+    return renderer_->Render(sim_->world(), sim_->robot_pose(), clock_.NowS(), nullptr);
+  }
+  std::optional<IntakeItem> Pick(const strategy::ObjectBelief&) override {
+    const std::optional<int> picked = sim_->Pick();
+    if (!picked) return std::nullopt;
+    return Item(*picked);  // the intake knows what it took (its own colour sensor)
+  }
+  std::optional<ReleaseOutcome> Release(int) override {
+    const std::optional<platform::ReleaseResult> released = sim_->Release();
+    if (!released) return std::nullopt;
+    return ReleaseOutcome{released->goal_index, false};
+  }
+  std::optional<IntakeItem> Preload() const override {
+    if (sim_->held().empty()) return std::nullopt;
+    return Item(sim_->held().front());
+  }
+  double OdometryScale() override { return CalibrateOdometryScale(robot_); }
+  std::optional<Pose2D> TruePose() const override { return sim_->robot_pose(); }
+  std::optional<int> Points() const override { return sim_->Score(alliance_); }
+  std::optional<std::vector<TrueObject>> TrueObjects() const override {
+    std::vector<TrueObject> out;
+    out.reserve(sim_->world().objects.size());
+    for (const platform::SimObject& o : sim_->world().objects) {
+      out.push_back(
+          {o.id, o.type->name, o.colour, o.center_m, o.type->size_m / 2.0, o.held, o.in_goal});
+    }
+    return out;
+  }
+  std::string Describe() const override { return "simulated field"; }
+
+ private:
+  std::optional<IntakeItem> Item(int id) const {
+    for (const platform::SimObject& o : sim_->world().objects) {
+      if (o.id == id) return IntakeItem{o.type->name, o.colour, false};
+    }
+    return std::nullopt;
+  }
+
+  field::Alliance alliance_;
+  uint64_t seed_;
+  field::RobotConfig robot_;
+  platform::SimClock clock_;
+  std::unique_ptr<platform::SimField> sim_;
+  std::unique_ptr<platform::SimRenderer> renderer_;
+  platform::SimGyro gyro_;
+};
+
+}  // namespace
+
+std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed) {
+  return std::make_unique<SimIo>(alliance, seed);
+}
+
+field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m,
+                                 uint64_t seed) {
+  field::SeasonConfig out = season;
+  if (jitter_m <= 0.0) return out;
+  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + 17);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (field::ObjectPlacement& p : out.objects) {
+    if (!p.position_m || p.z_m > 0.0) continue;
+    const Eigen::Vector2d nominal(p.position_m->x, p.position_m->y);
+    const bool preload =
+        std::any_of(season.starts.begin(), season.starts.end(), [&](const field::StartTile& s) {
+          return (nominal - Eigen::Vector2d(s.center_m.x, s.center_m.y)).norm() < 0.3;
+        });
+    if (preload) continue;
+    const field::ObjectType* type = season.FindObjectType(p.type);
+    const double r = type ? type->size_m / 2.0 : 0.1;
+    for (int attempt = 0; attempt < 30; ++attempt) {
+      const Eigen::Vector2d c = nominal + jitter_m * Eigen::Vector2d(unit(rng), unit(rng));
+      const double limit = season.HalfSize() - r;
+      if (std::abs(c.x()) > limit || std::abs(c.y()) > limit) continue;
+      if (platform::PointInBlockingStructure(season, c, r)) continue;
+      p.position_m = field::Vec2{c.x(), c.y()};
+      break;
+    }
+  }
+  return out;
+}
+
+MatchResult RunMatch(const field::SeasonConfig& season, const field::RobotConfig& robot,
+                     const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
+                     const std::function<void(const TimelineEntry&)>& progress) {
+  return RunMatchWith(strategy::MakeStrategy(setup.strategy, setup.strategy_options), season, robot,
+                      setup, seed, out_dir, progress);
+}
+
+MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
+                         const field::SeasonConfig& season, const field::RobotConfig& robot,
+                         const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
+                         const std::function<void(const TimelineEntry&)>& progress) {
+  return RunMatchOn(MakeSimIo(setup.alliance, seed), std::move(strategy),
+                    PlaceObjects(season, setup.placement_jitter_m, seed), robot, setup, seed,
+                    out_dir, progress);
+}
+
+}  // namespace slamo::autonomy

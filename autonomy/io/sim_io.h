@@ -1,0 +1,41 @@
+// The robot of a dry run: the simulated field behind RobotIo (autonomy/robot_io.h), the one
+// place the match loop's robot meets the simulator. It knows the truth: the true pose, the
+// points, where every object is.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "autonomy/loop/executive.h"
+#include "autonomy/loop/robot_io.h"
+#include "field_configs/robot_config.h"
+#include "field_configs/season_config.h"
+#include "strategy/strategy.h"
+
+namespace slamo::autonomy {
+
+// The simulated field of a dry run: SimField (drive base with slip, objects, opponents,
+// intake, scoring), its camera renderer and a yaw gyro, all seeded by `seed`; time on a
+// SimClock, so a dry run goes as fast as the computer allows and replays exactly.
+std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed);
+
+// The season with its fixed-position floor objects moved uniformly up to jitter_m (clear of
+// walls and structures), so no two seeds share a layout; preloads (objects on a starting
+// tile) stay.
+field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m, uint64_t seed);
+
+// A dry run: one autonomous period on the simulated field (MakeSimIo), its objects placed for
+// `seed` (PlaceObjects with setup.placement_jitter_m). `progress` (optional) hears each action
+// as it starts. When out_dir is set, the OctoMap object map is written there as objects.bt.
+MatchResult RunMatch(const field::SeasonConfig& season, const field::RobotConfig& robot,
+                     const MatchSetup& setup, uint64_t seed, const std::string& out_dir = "",
+                     const std::function<void(const TimelineEntry&)>& progress = {});
+// The same with a strategy of the caller's (setup.strategy is not used).
+MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
+                         const field::SeasonConfig& season, const field::RobotConfig& robot,
+                         const MatchSetup& setup, uint64_t seed, const std::string& out_dir = "",
+                         const std::function<void(const TimelineEntry&)>& progress = {});
+
+}  // namespace slamo::autonomy

@@ -1,0 +1,82 @@
+// The executive: one simulated autonomous period, end to end (see RunMatch in executive.cc,
+// which reads as the match loop from top to bottom).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "autonomy/loop/match_world.h"
+#include "field_configs/robot_config.h"
+#include "field_configs/season_config.h"
+#include "strategy/strategy.h"
+
+namespace slamo::autonomy {
+
+struct TimelineEntry {
+  double t_s = 0.0;    // when the action started
+  double end_s = 0.0;  // when it ended
+  std::string action;  // OBSERVE, NAVIGATE, PICK, SCORE, IDLE, or REFUSED (would overrun)
+  std::string detail;
+  bool ok = true;
+  double expected_s = 0.0;  // the strategy's estimate
+};
+
+struct ObjectReport {
+  int id = 0;
+  std::string kind;
+  std::string colour;
+  Eigen::Vector2d estimate_m = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  bool matched = false;  // a true object of its kind and colour within 0.5 m
+  Eigen::Vector2d truth_m = Eigen::Vector2d::Zero();
+  double error_m = 0.0;
+};
+
+struct MatchResult {
+  std::string robot_io;                 // what the match ran on (RobotIo::Describe)
+  bool truth_known = true;              // false on hardware: points and object errors are unknown
+  std::map<std::string, double> board;  // hardware counters (RobotIo::Status)
+  std::string season;
+  uint64_t seed = 0;
+  std::string strategy;
+  std::string frames;    // the frame rule, described
+  int points = 0;        // the alliance's score at the deadline
+  int points_start = 0;  // ... and at the start (objects already in scoring zones)
+  double deadline_s = 0.0;
+  double duration_s = 0.0;  // until the last motion command (never after the deadline)
+  double overrun_s = 0.0;   // motors driven after the deadline (goal: 0)
+  int refused = 0;          // actions not started because they could not finish in time
+  double pose_ate_m = 0.0;  // RMS position error of the estimate at every filter update (NaN:
+                            // no truth)
+  double observe_s = 0.0, drive_s = 0.0, score_s = 0.0, idle_s = 0.0;
+  int frames_taken = 0;
+  int replans = 0;
+  int relocalisations = 0;      // frames paired again after widening a lost pose belief
+  int rejected_frames = 0;      // frames whose update would have thrown the pose off
+  double odometry_scale = 1.0;  // true distance per encoder distance, calibrated before the match
+  double wall_s = 0.0;          // compute time of the run on this machine
+  std::vector<ObjectReport> objects;
+  std::vector<TimelineEntry> timeline;
+  std::vector<PoseSample> samples;
+  std::vector<Snapshot> snapshots;
+  std::vector<std::vector<Eigen::Vector2d>> paths;
+  std::vector<Eigen::Vector2d> landmark_estimates, landmark_truth;
+  std::vector<Eigen::Matrix2d> landmark_covariances;
+  field::SeasonConfig field;  // the season as placed for this seed
+};
+
+// One autonomous period on `io` (the robot: autonomy/hardware_io.h), with the season's objects
+// where its file puts them; `seed` seeds the planners. Truth-based figures (points, ATE,
+// object errors) are reported only when `io` knows the truth.
+MatchResult RunMatchOn(std::unique_ptr<RobotIo> io, std::unique_ptr<strategy::Strategy> strategy,
+                       const field::SeasonConfig& season, const field::RobotConfig& robot,
+                       const MatchSetup& setup, uint64_t seed, const std::string& out_dir = "",
+                       const std::function<void(const TimelineEntry&)>& progress = {});
+
+}  // namespace slamo::autonomy

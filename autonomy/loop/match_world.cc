@@ -1,0 +1,510 @@
+#include "autonomy/loop/match_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+#include "platform/field_geometry.h"
+
+namespace slamo::autonomy {
+namespace {
+
+using platform::DriveStep;
+using platform::DriveStepKind;
+using platform::Pose2D;
+
+using platform::kPi;
+
+DriveStep Turn(double degrees) {
+  return {DriveStepKind::kTurn, degrees, "turn " + std::to_string(degrees)};
+}
+DriveStep Forward(double metres) {
+  return {DriveStepKind::kDrive, metres,
+          (metres >= 0 ? "forward " : "back ") + std::to_string(std::abs(metres))};
+}
+
+// Frames taken to check an arrival, and how close counts as arrived.
+// Cut the motors this long before the target at the current speed: the slow creep of the last
+// centimetres (PWM deadband) costs more time than the coast-in error SLAM-O corrects.
+constexpr double kStopLead_s = 0.15;
+constexpr double kMinSpeed_mps = 0.06;
+
+// How far the robot backs off a goal after a release.
+constexpr double kBackOff_m = 0.15;
+
+// The robot as driven in a match: at its match speed (or `speed_mps`), turning in place at
+// that wheel speed, which is what the drive controller does.
+field::RobotConfig MatchRobot(const field::RobotConfig& robot, double speed_mps) {
+  field::RobotConfig out = robot;
+  out.drive.cruise_speed_mps = speed_mps > 0.0 ? std::min(speed_mps, robot.drive.max_speed_mps)
+                                               : robot.drive.match_speed_mps;
+  out.drive.turn_rate_dps =
+      out.drive.cruise_speed_mps / (robot.drive.track_width_m / 2.0) * 180.0 / kPi;
+  return out;
+}
+
+}  // namespace
+
+mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
+                            const platform::Pose2D& start, bool relocalise) {
+  mapping::SlamOPrior prior;
+  prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
+  prior.covariance = Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal();
+  prior.surveyed_markers = platform::SurveyedMarkers(field);
+  prior.marker_sigma_m = 1e-3;
+  mapping::SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  options.relocalise = relocalise;
+  return mapping::SlamO(field, robot.camera, prior, options);
+}
+
+MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& season,
+                       const field::RobotConfig& robot, const MatchSetup& setup, uint64_t seed,
+                       bool perceive)
+    : field_(season),
+      robot_(MatchRobot(robot, setup.drive_speed_mps)),
+      setup_(setup),
+      perceive_(perceive),
+      deadline_s_(season.rules.autonomous_s),
+      io_(std::move(io)),
+      slam_(SurveyedSlam(field_, robot_,
+                         platform::StartPose(field_, setup.alliance, setup.start_index), true)),
+      travel_(robot_.drive) {
+  const Pose2D start_pose = platform::StartPose(field_, setup.alliance, setup.start_index);
+  io_->Start(field_, robot_, start_pose);
+  markers_ = platform::SurveyedMarkers(field_);
+  // The preload: loaded by hand, so its kind and colour are known.
+  if (const std::optional<IntakeItem> preload = io_->Preload()) {
+    strategy::ObjectBelief held;
+    held.id = -1;
+    held.kind = preload->kind;
+    held.colour = preload->colour;
+    held_ = held;
+  }
+  odometry_ = io_->OdometryPose();
+  if (setup_.gyro) {
+    const std::optional<double> heading = io_->GyroHeadingRad();
+    if (!heading) {
+      throw std::invalid_argument(
+          "this robot has no yaw gyro (" + io_->Describe() +
+          "): run without gyro-aided odometry (MatchSetup::gyro = false, --no-gyro)");
+    }
+    gyro_heading_ = *heading;
+  }
+  odometry_scale_ = io_->OdometryScale();
+  drive_options_ = platform::DriveControllerOptionsFor(robot_.drive);
+  drive_options_.hard_deadline_s = deadline_s_;
+  drive_options_.timeout_margin_s = 2.0;  // a blocked step gives up quickly in a match
+  // Do not wait for the last encoder tick of a coasting wheel: the odometry keeps counting
+  // it into the next step.
+  drive_options_.max_settle_s = 0.4;
+  drive_options_.stop_lead_s = kStopLead_s;
+  drive_options_.min_speed_mps = kMinSpeed_mps;
+
+  planning::PlannerOptions planner_options;
+  planner_options.stop_spacing_m = 0.0;
+  planner_ = std::make_unique<planning::Planner>(robot_, planner_options);
+  planning::SeedPlanners(seed);
+  planner_->SetMap(slam_.obstacle_map());
+  travel_.SetPlanner(*planner_);
+
+  context_.season = &field_;
+  context_.robot = &robot_;
+  context_.alliance = setup.alliance;
+  context_.frame_rate_hz = robot_.camera.frame_rate_hz;
+  context_.travel_time_s = [this](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+    return travel_.TravelTimeS(from, to);
+  };
+  context_.is_clear = [this](const Eigen::Vector2d& p) { return planner_->IsClear(p); };
+  RecordSample();
+  MaybeSnapshot(true);
+}
+
+strategy::Belief MatchWorld::Belief() const {
+  strategy::Belief b;
+  b.now_s = now_s();
+  b.deadline_s = deadline_s_;
+  b.pose = slam_.pose();
+  b.pose_covariance = slam_.pose_covariance();
+  b.held = held_;
+  for (const mapping::TrackedObject& o : slam_.ConfirmedObjects(picked_ids_))
+    b.objects.push_back({o.id, o.kind, o.colour, o.position_m, o.covariance, o.confidence});
+  return b;
+}
+
+double MatchWorld::ObjectRadius(const std::string& kind) const {
+  const field::ObjectType* type = field_.FindObjectType(kind);
+  return type ? type->size_m / 2.0 : 0.1;
+}
+
+void MatchWorld::Advance(double dt_s) {
+  const double before_s = now_s();
+  io_->Advance(dt_s);
+  if (io_->MotorsDriven()) {
+    last_motion_s_ = now_s();
+    if (before_s >= deadline_s_) overrun_s_ += now_s() - before_s;
+  }
+}
+
+void MatchWorld::RecordSample() {
+  PoseSample sample{now_s(), Eigen::Vector3d::Zero(), slam_.pose(), slam_.pose_covariance(), false};
+  if (const std::optional<Pose2D> t = io_->TruePose()) {
+    sample.truth_known = true;
+    sample.truth = Eigen::Vector3d(t->x_m, t->y_m, t->theta_rad);
+  }
+  samples_.push_back(sample);
+}
+
+void MatchWorld::MaybeSnapshot(bool force) {
+  if (setup_.snapshot_period_s <= 0.0) return;
+  if (!force && now_s() < next_snapshot_s_) return;
+  next_snapshot_s_ = now_s() + setup_.snapshot_period_s;
+  Snapshot s;
+  s.t_s = now_s();
+  const std::optional<Pose2D> truth = io_->TruePose();
+  s.truth_known = truth.has_value();
+  if (truth) s.truth = *truth;
+  // Between filter updates the estimate is the last one moved by the encoders since.
+  mapping::OdometryStep u = mapping::OdometryIncrement(odometry_, io_->OdometryPose());
+  u.dx_m *= odometry_scale_;
+  u.dy_m *= odometry_scale_;
+  s.estimate = mapping::EkfSlam::Move(slam_.pose(), u, nullptr, nullptr);
+  s.covariance = slam_.pose_covariance();
+  if (const std::optional<std::vector<TrueObject>> truth = io_->TrueObjects()) {
+    for (const TrueObject& o : *truth) {
+      if (o.held) continue;
+      s.truth_objects.push_back({o.center_m.head<2>(), o.colour, o.radius_m});
+    }
+  }
+  s.tracked = Belief().objects;
+  s.action = action_label_;
+  s.points = Points().value_or(0);
+  snapshots_.push_back(std::move(s));
+}
+
+bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
+  platform::DriveBodyLink body = DriveLinkFor(*io_, robot_);
+  body.advance = [this](double dt) {
+    Advance(dt);
+    MaybeSnapshot();
+  };
+  const std::vector<platform::DriveStepResult> results =
+      platform::RunDriveScript(steps, drive_options_, body);
+  const Pose2D now = io_->OdometryPose();
+  mapping::OdometryStep u = mapping::OdometryIncrement(odometry_, now);
+  u.dx_m *= odometry_scale_;
+  u.dy_m *= odometry_scale_;
+  if (setup_.gyro) {
+    // Gyro-aided odometry: the turn comes from the gyro, which sees the body turn; the
+    // encoders' turn is wrong whenever a wheel slips (and a turn blocked by a pinned object
+    // spins the wheels without turning the robot at all).
+    const double heading = io_->GyroHeadingRad().value_or(gyro_heading_);
+    u.dtheta_rad = platform::WrapAngleRad(heading - gyro_heading_);
+    gyro_heading_ = heading;
+  }
+  slam_.Predict(u);
+  odometry_ = now;
+  RecordSample();
+  return std::all_of(results.begin(), results.end(), [](const platform::DriveStepResult& r) {
+    return r.status == platform::DriveStepStatus::kDone;
+  });
+}
+
+void MatchWorld::Wait(double seconds) { Drive({DriveStep{DriveStepKind::kWait, seconds, "wait"}}); }
+
+int MatchWorld::Observe(int max_frames) {
+  if (!perceive_ || max_frames <= 0) return 0;
+  mapping::FrameSelectionOptions rule = setup_.frames;
+  rule.max_frames = std::min(rule.max_frames, max_frames);
+  rule.fixed_frames = std::min(rule.fixed_frames, max_frames);
+  rule.gmm_max_frames = std::min(rule.gmm_max_frames, max_frames);
+  rule.gmm_min_frames = std::min(rule.gmm_min_frames, max_frames);
+  slam_.BeginStop(rule);
+  platform::RgbdFrame rgbd;
+  int taken = 0;
+  bool last_tracked = false;
+  int missed_frames = 0;
+  const double dt = 1.0 / robot_.camera.frame_rate_hz;
+  while (now_s() < deadline_s_) {
+    std::optional<platform::RgbdFrame> captured = io_->Capture();
+    if (!captured) {
+      // No frame from the camera (RobotIo::Capture waited for one): try again a frame period
+      // later, and give up the look after three misses in a row.
+      if (++missed_frames >= 3) break;
+      Advance(dt);
+      continue;
+    }
+    missed_frames = 0;
+    rgbd = std::move(*captured);
+    const mapping::LandmarkFrame update = slam_.UpdateLandmarks(rgbd);
+    // Objects on the first frame and the last: two sightings confirm an object, so a single
+    // stop can map what it sees; a false detection rarely survives both.
+    if (taken == 0) slam_.TrackObjects(rgbd, now_s());
+    last_tracked = taken == 0;
+    ++taken;
+    ++frames_;
+    Advance(dt);
+    RecordSample();
+    MaybeSnapshot();
+    if (!update.more_frames) break;
+  }
+  if (taken == 0) return 0;
+  if (!last_tracked) slam_.TrackObjects(rgbd, now_s());
+  UpdateMaps();
+  return taken;
+}
+
+void MatchWorld::UpdateMaps() {
+  // Objects narrower than half the robot are pushed aside by it (the simulator's contact
+  // rule; VEX robots sweep small balls): they are mapped but not planned around. Larger ones
+  // are obstacles: pushed, they pin against others and stop the robot. An obstacle has no
+  // clearance margin: grazing a ball only nudges it, and the full margin would close the
+  // approaches to the goals the balls lie around.
+  mapping::ObstacleRule obstacles;
+  obstacles.min_size_m = setup_.pushable_fraction * robot_.width_m;
+  obstacles.shrink_m = planner_->inflation_radius_m();
+  obstacles.grow_m = robot_.width_m / 2.0;
+  slam_.UpdateMaps(picked_ids_, obstacles);
+  planner_->SetMap(slam_.obstacle_map());
+  travel_.SetPlanner(*planner_);
+}
+
+bool MatchWorld::TurnTo(double heading_rad) {
+  const double turn = platform::WrapAngleRad(heading_rad - slam_.pose().z());
+  if (std::abs(turn) < 2.0 * kPi / 180.0) return true;
+  return Drive({Turn(turn * 180.0 / kPi)});
+}
+
+bool MatchWorld::PathClear(const std::vector<Eigen::Vector2d>& path) const {
+  // A robot standing inside the clearance margin (after a close approach) may leave it: the
+  // stretch that starts blocked is not held against the path.
+  bool leaving = !path.empty() && !planner_->IsClear(path.front());
+  for (size_t i = 1; i < path.size(); ++i) {
+    const double length = (path[i] - path[i - 1]).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(length / 0.02)));
+    for (int k = 0; k <= n; ++k) {
+      const bool clear =
+          planner_->IsClear(path[i - 1] + (path[i] - path[i - 1]) * (static_cast<double>(k) / n));
+      if (clear) leaving = false;
+      if (!clear && !leaving) return false;
+    }
+  }
+  return true;
+}
+
+bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, int frames_per_stop,
+                          double budget_s) {
+  const double give_up_s = budget_s > 0.0 ? now_s() + budget_s : deadline_s_;
+  const auto out_of_time = [&]() { return now_s() >= std::min(give_up_s, deadline_s_); };
+  for (int attempt = 0; attempt < 3 && !out_of_time(); ++attempt) {
+    Eigen::Vector3d pose = slam_.pose();
+    if (!planner_->IsClear(pose.head<2>())) {
+      // After a close approach the robot stands inside the clearance margin: back out, along
+      // its heading, to the nearest clear point behind it (or turn away first if there is none).
+      const Eigen::Vector2d back(-std::cos(pose.z()), -std::sin(pose.z()));
+      double distance = 0.0;
+      for (double d = 0.05; d <= 0.8 + 1e-9; d += 0.05) {
+        if (planner_->IsClear(pose.head<2>() + d * back)) {
+          distance = d + 0.03;
+          break;
+        }
+      }
+      if (distance > 0.0) {
+        Drive({Forward(-distance / odometry_scale_)});
+      } else {
+        Drive({Turn(180.0), Forward(0.3 / odometry_scale_)});
+      }
+      pose = slam_.pose();
+    }
+    planning::PlanRequest request;
+    request.start_x_m = pose.x();
+    request.start_y_m = pose.y();
+    request.start_heading_deg = pose.z() * 180.0 / kPi;
+    request.goal_x_m = target.x();
+    request.goal_y_m = target.y();
+    request.goal_heading_deg = target.z() * 180.0 / kPi;
+    request.planner = setup_.planner;
+    request.time_budget_s = setup_.plan_budget_s;
+    request.max_iterations = setup_.plan_iterations;
+    planning::PlanResult plan = planner_->Plan(request);
+    if (plan.status != planning::PlanStatus::kSolved) {
+      return false;
+    }
+    // Fewer corners, fewer stops to turn: keep only the corners a straight, clear segment
+    // cannot skip (the planner's taut paths bend in small steps round the inflated discs).
+    std::vector<Eigen::Vector2d> corners = {plan.path.front()};
+    for (size_t from = 0; from + 1 < plan.path.size();) {
+      size_t to = plan.path.size() - 1;
+      while (to > from + 1 && !PathClear({plan.path[from], plan.path[to]})) --to;
+      corners.push_back(plan.path[to]);
+      from = to;
+    }
+    plan.path = corners;
+    paths_.push_back(plan.path);
+    // Stops: the strategy's, or (perceiving) a quick look every setup_.check_spacing_m, which
+    // catches obstacles the map did not have and the wheels' slip.
+    const double spacing = stop_spacing_m > 0.0                        ? stop_spacing_m
+                           : perceive_ && setup_.check_spacing_m > 0.0 ? setup_.check_spacing_m
+                                                                       : 0.0;
+    const int stop_frames = stop_spacing_m > 0.0 ? frames_per_stop : setup_.correction_frames;
+    // The path's corners, with stops added along each leg every `spacing` (a stop never cuts
+    // a corner: the legs between stops are the plan's own).
+    std::vector<Eigen::Vector2d> waypoints;
+    for (size_t k = 1; k < plan.path.size(); ++k) {
+      const Eigen::Vector2d a = plan.path[k - 1], b = plan.path[k];
+      const int pieces =
+          spacing > 0.0 ? std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing))) : 1;
+      for (int j = 1; j <= pieces; ++j)
+        waypoints.push_back(a + (b - a) * (static_cast<double>(j) / pieces));
+    }
+    bool replan = false;
+    double unseen_m =
+        setup_.check_spacing_m;  // driven since the last look (look before the first leg)
+    for (size_t i = 0; i < waypoints.size() && !replan; ++i) {
+      if (out_of_time()) return false;
+      // Each segment is aimed from the latest estimate: SLAM-O corrects the encoders' drift.
+      Eigen::Vector3d est = slam_.pose();
+      Eigen::Vector2d d = waypoints[i] - est.head<2>();
+      if (d.norm() < 0.02) continue;
+      const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+      // The thesis's stops come at every stop point; the quick looks once per
+      // setup_.check_spacing_m.
+      const bool stop_here = stop_spacing_m > 0.0 || unseen_m + 1e-6 >= setup_.check_spacing_m;
+      unseen_m = stop_here ? d.norm() : unseen_m + d.norm();
+      if (spacing > 0.0 && stop_frames > 0 && stop_here) {
+        // Face the segment, look along it, and plan again if the map now blocks the rest.
+        if (std::abs(turn) > 3.0 * kPi / 180.0) Drive({Turn(turn * 180.0 / kPi)});
+        Observe(stop_frames);
+        // The planned legs ahead (the leg from here is the plan's, up to the drift the
+        // estimate just corrected).
+        std::vector<Eigen::Vector2d> rest = {i == 0 ? pose.head<2>() : waypoints[i - 1]};
+        rest.insert(rest.end(), waypoints.begin() + static_cast<long>(i), waypoints.end());
+        if (!PathClear(rest)) {
+          replan = true, ++replans_;
+          break;
+        }
+        est = slam_.pose();
+        d = waypoints[i] - est.head<2>();
+        const double again = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+        std::vector<DriveStep> steps;
+        if (std::abs(again) > 2.0 * kPi / 180.0) steps.push_back(Turn(again * 180.0 / kPi));
+        steps.push_back(Forward(d.norm() / odometry_scale_));
+        Drive(steps);
+      } else {
+        Drive({Turn(turn * 180.0 / kPi), Forward(d.norm() / odometry_scale_)});
+      }
+    }
+    if (replan) continue;
+    // Arrival, closed on SLAM-O: observe, and drive the rest while the estimate is off.
+    for (int fix = 0; perceive_ && fix < setup_.arrival_fixes && !out_of_time(); ++fix) {
+      Observe(std::max(frames_per_stop, setup_.correction_frames));
+      const Eigen::Vector2d d = target.head<2>() - slam_.pose().head<2>();
+      if (d.norm() < setup_.arrival_tolerance_m) break;
+      const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - slam_.pose().z());
+      if (std::abs(turn) > kPi / 2) {  // overshot: back up rather than turn round
+        Drive({Turn(platform::WrapAngleRad(turn + kPi) * 180.0 / kPi),
+               Forward(-d.norm() / odometry_scale_)});
+      } else {
+        Drive({Turn(turn * 180.0 / kPi), Forward(d.norm() / odometry_scale_)});
+      }
+    }
+    TurnTo(target.z());
+    return (slam_.pose().head<2>() - target.head<2>()).norm() < 0.12;
+  }
+  return false;
+}
+
+bool MatchWorld::Pick(const strategy::Action& action) {
+  const strategy::Belief before = Belief();
+  strategy::ObjectBelief target;
+  target.position_m = action.target.head<2>();
+  for (const strategy::ObjectBelief& o : before.objects) {
+    if (o.id == action.object_id) target = o;
+  }
+  if (perceive_) {
+    Observe(std::max(action.frames, setup_.correction_frames));
+    for (const strategy::ObjectBelief& o : Belief().objects) {
+      if (o.id == action.object_id) target = o;
+    }
+  }
+  const double r =
+      ObjectRadius(target.kind.empty() ? field_.object_types.front().name : target.kind);
+  const Eigen::Vector3d est = slam_.pose();
+  const Eigen::Vector2d d = target.position_m - est.head<2>();
+  const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+  const double forward = d.norm() - strategy::PickDistance(robot_, r);
+  std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};
+  if (std::abs(forward) > 0.01) steps.push_back(Forward(forward / odometry_scale_));
+  Drive(steps);
+  if (now_s() >= deadline_s_) return false;
+  const std::optional<IntakeItem> picked = io_->Pick(target);
+  Wait(context_.robot ? setup_.strategy_options.pick_s : 1.0);
+  if (!picked) return false;
+  // The intake knows what it took (kind and colour from its own sensor, or taken on trust).
+  // Another kind or colour than the target's: the intake took a neighbour, and the target is
+  // still on the field (the tracker lets the one taken fade from view).
+  const bool took_target =
+      target.kind.empty() || (picked->kind == target.kind && picked->colour == target.colour);
+  strategy::ObjectBelief held;
+  held.id = took_target ? action.object_id : -1;
+  held.kind = picked->kind;
+  held.colour = picked->colour;
+  held_ = held;
+  if (took_target && action.object_id >= 0) picked_ids_.push_back(action.object_id);
+  UpdateMaps();
+  return took_target;
+}
+
+bool MatchWorld::Score(const strategy::Action& action) {
+  if (!held_) return false;
+  const double r = ObjectRadius(held_->kind);
+  const double margin = setup_.strategy_options.approach_margin_m;
+  Observe(setup_.correction_frames);
+  const Eigen::Vector2d drop =
+      strategy::DropTarget(field_, robot_, action.goal_index, action.target, r, margin);
+  const Eigen::Vector3d est = slam_.pose();
+  const Eigen::Vector2d d = drop - est.head<2>();
+  const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+  const field::Goal& goal = field_.goals[action.goal_index];
+  // Into a goal structure the bumper stops just short of its edge.
+  double forward = d.norm() - strategy::ReleaseDistance(robot_, r);
+  if (goal.kind == field::GoalKind::kGoal) {
+    const double half = goal.shape == field::SolidShape::kCylinder
+                            ? goal.radius_m
+                            : 0.5 * std::min(goal.size_m.x, goal.size_m.y);
+    forward = d.norm() - (half + robot_.length_m / 2.0 + 0.015);
+  }
+  std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};
+  if (std::abs(forward) > 0.01) steps.push_back(Forward(forward / odometry_scale_));
+  Drive(steps);
+  if (now_s() >= deadline_s_) return false;
+  const std::optional<ReleaseOutcome> released = io_->Release(action.goal_index);
+  Wait(setup_.strategy_options.release_s);
+  // Back off the goal: pressed against it, the robot could not turn (its corners sweep the
+  // structure) and its wheels would spin in place.
+  if (now_s() < deadline_s_) Drive({Forward(-kBackOff_m / odometry_scale_)});
+  if (!released) return false;
+  held_.reset();
+  return released->goal_index && *released->goal_index == action.goal_index;
+}
+
+bool MatchWorld::Drop(const strategy::Action& action) {
+  if (!held_) return false;
+  TurnTo(action.target.z());
+  if (now_s() >= deadline_s_) return false;
+  // No back-off as after a score: nothing presses against the robot here.
+  const std::optional<ReleaseOutcome> released = io_->Release(-1);
+  Wait(setup_.strategy_options.release_s);
+  if (!released) return false;
+  held_.reset();
+  return true;
+}
+
+void MatchWorld::IdleToDeadline() {
+  if (now_s() < deadline_s_) Wait(deadline_s_ - now_s());
+  MaybeSnapshot(true);
+}
+
+}  // namespace slamo::autonomy

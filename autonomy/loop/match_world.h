@@ -1,0 +1,190 @@
+// Everything one match runs on, behind the operations the executive needs: the robot (through
+// RobotIo: the simulated field and its camera in a dry run, the board and a camera on match
+// day), SLAM-O (EKF over pose and surveyed markers, the object
+// tracker, the OctoMap object map), the planner on that map and the travel times the strategy
+// asks for. Each operation advances the match clock and stops at the deadline; the robot is
+// only ever steered from SLAM-O's estimate, never from the simulator's truth (the truth, when
+// there is one, is recorded for the report).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "autonomy/loop/robot_io.h"
+#include "field_configs/robot_config.h"
+#include "field_configs/season_config.h"
+#include "mapping/frame_selection.h"
+#include "mapping/slam_o.h"
+#include "planning/planner.h"
+#include "platform/clock.h"
+#include "platform/drive_script.h"
+#include "strategy/strategy.h"
+#include "strategy/travel_field.h"
+
+namespace slamo::autonomy {
+
+struct MatchSetup {
+  std::string strategy = "planner";  // strategy::StrategyNames()
+  strategy::StrategyOptions strategy_options;
+  mapping::FrameSelectionOptions frames;  // the rule for every observation (cap: the action's)
+  field::Alliance alliance = field::Alliance::kRed;
+  int start_index = 0;               // among the alliance's starting tiles
+  double placement_jitter_m = 0.15;  // fixed-position objects moved up to this per seed
+  std::string planner = "rrtconnect";
+  double plan_budget_s = 0.05;
+  // Planner iterations per attempt instead of a time budget, so that a match depends only on
+  // its seed, not on how busy the machine is (PlanRequest::max_iterations; 0: the budget).
+  int plan_iterations = 10000;
+  double snapshot_period_s = 0.25;  // match time between replay snapshots (0: none)
+  double drive_speed_mps = 0.0;     // 0: the robot's drive.match_speed_mps
+  // How the executive drives with SLAM-O (perceiving strategies): a quick look of
+  // correction_frames every check_spacing_m of path (0: none); on arrival up to arrival_fixes
+  // rounds of look-and-correct until within arrival_tolerance_m; objects narrower than
+  // pushable_fraction of the robot's width are pushed aside, not planned round.
+  double check_spacing_m = 1.2;
+  int correction_frames = 5;
+  int arrival_fixes = 2;
+  double arrival_tolerance_m = 0.04;
+  double pushable_fraction = 1.0;
+  bool gyro =
+      true;  // the turn of every motion from a yaw gyro, not the encoders (VEX robots carry one)
+};
+
+// A moment of the match for the replay and the map picture.
+struct Snapshot {
+  double t_s = 0.0;
+  bool truth_known = true;  // false on hardware: truth and truth_objects are empty
+  platform::Pose2D truth;
+  Eigen::Vector3d estimate = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  struct Object {
+    Eigen::Vector2d position_m;
+    std::string colour;
+    double radius_m = 0.0;
+  };
+  std::vector<Object> truth_objects;  // on the floor, in the simulator
+  std::vector<strategy::ObjectBelief> tracked;
+  std::string action;
+  int points = 0;
+};
+
+// Estimate against truth at the same instant (every filter update), for ATE and the TUM file.
+struct PoseSample {
+  double t_s = 0.0;
+  Eigen::Vector3d truth = Eigen::Vector3d::Zero();
+  Eigen::Vector3d estimate = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  bool truth_known = true;  // false on hardware (truth is then zero)
+};
+
+class MatchWorld {
+ public:
+  // On `io` (the robot), the season's objects where its file puts them; `seed` seeds the
+  // planners. Calls io->Start().
+  MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& season,
+             const field::RobotConfig& robot, const MatchSetup& setup, uint64_t seed,
+             bool perceive);
+
+  double now_s() const { return io_->clock().NowS(); }
+  double deadline_s() const { return deadline_s_; }
+  double time_left_s() const { return deadline_s_ - now_s(); }
+
+  strategy::Belief Belief() const;
+  const strategy::StrategyContext& Context() const { return context_; }
+
+  // Observes up to max_frames (the frame rule may stop earlier), landmarks every frame and
+  // objects on the last; the map and the planner follow. Returns the frames taken.
+  int Observe(int max_frames);
+  // Turns in place to a field heading.
+  bool TurnTo(double heading_rad);
+  // Plans from the estimated pose to `target` and follows the path turn-then-drive, each
+  // segment aimed from the latest estimate; observes frames_per_stop at stops every
+  // stop_spacing_m; replans when an observation puts an obstacle on the rest of the path.
+  // Gives up (false) when it has taken budget_s (<= 0: no limit).
+  bool Navigate(const Eigen::Vector3d& target, double stop_spacing_m, int frames_per_stop,
+                double budget_s = 0.0);
+  // Final approach to an object believed at target.xy and the intake; true when the intake
+  // took an object of the target's kind and colour (another one is held, but the pick
+  // failed).
+  bool Pick(const strategy::Action& action);
+  // Final approach to the goal and the release; true when the object landed where intended.
+  bool Score(const strategy::Action& action);
+  // Turns to action.target's heading and releases the held object there, on the floor;
+  // true when it left the intake.
+  bool Drop(const strategy::Action& action);
+  // Stands still until the deadline.
+  void IdleToDeadline();
+
+  // The alliance's points now, when known (the simulator).
+  std::optional<int> Points() const { return io_->Points(); }
+  const field::SeasonConfig& field() const { return field_; }
+  RobotIo& io() { return *io_; }
+  const RobotIo& io() const { return *io_; }
+  // SLAM-O: the EKF, the object tracker and the maps.
+  const mapping::SlamO& slam() const { return slam_; }
+  const std::vector<PoseSample>& samples() const { return samples_; }
+  const std::vector<Snapshot>& snapshots() const { return snapshots_; }
+  const std::vector<std::vector<Eigen::Vector2d>>& paths() const { return paths_; }
+  // The surveyed marker centres (what SLAM-O is given, and on the simulated field the truth).
+  const std::vector<Eigen::Vector2d>& landmark_truth() const { return markers_; }
+  double overrun_s() const { return overrun_s_; }
+  int frames() const { return frames_; }
+  int replans() const { return replans_; }
+  int relocalisations() const { return slam_.relocalisations(); }
+  int rejected_frames() const { return slam_.gated_frames(); }
+  double odometry_scale() const { return odometry_scale_; }
+  double last_motion_s() const { return last_motion_s_; }
+  void set_action_label(const std::string& label) { action_label_ = label; }
+
+ private:
+  bool Drive(const std::vector<platform::DriveStep>& steps);
+  void Wait(double seconds);
+  void Advance(double dt_s);
+  void RecordSample();
+  void MaybeSnapshot(bool force = false);
+  void UpdateMaps();
+  void Init(uint64_t seed);
+  bool PathClear(const std::vector<Eigen::Vector2d>& path) const;
+  double ObjectRadius(const std::string& kind) const;
+
+  field::SeasonConfig field_;  // the season with this match's object placement
+  field::RobotConfig robot_;
+  MatchSetup setup_;
+  bool perceive_;
+  double deadline_s_;
+  std::unique_ptr<RobotIo> io_;
+  mapping::SlamO slam_;  // the EKF, the object tracker, the object and obstacle maps
+  std::vector<Eigen::Vector2d> markers_;
+  std::unique_ptr<planning::Planner> planner_;
+  double gyro_heading_ = 0.0;  // the gyro's reading at the last prediction
+  strategy::TravelField travel_;
+  strategy::StrategyContext context_;
+  platform::DriveControllerOptions drive_options_;
+  platform::Pose2D odometry_;    // the encoders' pose at the last prediction
+  double odometry_scale_ = 1.0;  // true distance per encoder distance, calibrated
+  std::optional<strategy::ObjectBelief> held_;
+  std::vector<int> picked_ids_;  // tracker ids of objects taken off the field
+  std::vector<PoseSample> samples_;
+  std::vector<Snapshot> snapshots_;
+  std::vector<std::vector<Eigen::Vector2d>> paths_;
+  std::string action_label_;
+  double next_snapshot_s_ = 0.0;
+  double overrun_s_ = 0.0;
+  double last_motion_s_ = 0.0;
+  int frames_ = 0;
+  int replans_ = 0;
+};
+
+// SLAM-O as a match runs it: from `start`, known to a centimetre and a degree, over the
+// season's surveyed markers, known to a millimetre and all there is (no new landmarks); with
+// `relocalise`, a belief that left the truth is widened and paired again.
+mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
+                            const platform::Pose2D& start, bool relocalise);
+
+}  // namespace slamo::autonomy
