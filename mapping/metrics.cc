@@ -65,10 +65,11 @@ TimedPose Rigid2d::Apply(const TimedPose& pose) const {
   return {pose.t_s, p.x(), p.y(), std::remainder(pose.theta_rad + theta_rad, 2.0 * M_PI)};
 }
 
-void WriteTumTrajectory(const std::string& path, const std::vector<TimedPose>& poses) {
+void WriteTumTrajectory(const std::string& path, const std::vector<TimedPose>& poses,
+                        const std::string& what) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot open for writing");
-  out << "# timestamp tx ty tz qx qy qz qw\n";
+  out << "# " << (what.empty() ? "" : what + ": ") << "timestamp tx ty tz qx qy qz qw\n";
   char line[256];
   for (const TimedPose& p : poses) {
     std::snprintf(line, sizeof(line), "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.t_s, p.x_m, p.y_m,
@@ -170,6 +171,35 @@ Rigid2d AlignRigid(const std::vector<Eigen::Vector2d>& from,
   return result;
 }
 
+AteResult PairedTrajectoryError(const std::vector<Eigen::Vector2d>& truth,
+                                const std::vector<Eigen::Vector2d>& estimate, bool align) {
+  if (truth.empty() || truth.size() != estimate.size()) {
+    throw std::invalid_argument("trajectory error: " + std::to_string(truth.size()) + " true and " +
+                                std::to_string(estimate.size()) +
+                                " estimated positions; expected as many of each, at least one");
+  }
+  AteResult result;
+  if (align) result.alignment = AlignRigid(estimate, truth);
+  std::vector<double> errors;
+  double sum = 0.0, sum_sq = 0.0;
+  for (size_t k = 0; k < estimate.size(); ++k) {
+    const double e2 = (result.alignment.Apply(estimate[k]) - truth[k]).squaredNorm();
+    const double e = std::sqrt(e2);
+    errors.push_back(e);
+    sum += e;
+    sum_sq += e2;
+    result.max_m = std::max(result.max_m, e);
+  }
+  const double n = static_cast<double>(errors.size());
+  result.pairs = static_cast<int>(errors.size());
+  result.rmse_m = std::sqrt(sum_sq / n);
+  result.mean_m = sum / n;
+  std::sort(errors.begin(), errors.end());
+  const size_t mid = errors.size() / 2;
+  result.median_m = errors.size() % 2 ? errors[mid] : 0.5 * (errors[mid - 1] + errors[mid]);
+  return result;
+}
+
 AteResult AbsoluteTrajectoryError(const std::vector<TimedPose>& truth,
                                   const std::vector<TimedPose>& estimate, double max_dt_s,
                                   bool align) {
@@ -183,25 +213,7 @@ AteResult AbsoluteTrajectoryError(const std::vector<TimedPose>& truth,
     to.emplace_back(truth[i].x_m, truth[i].y_m);
     from.emplace_back(estimate[j].x_m, estimate[j].y_m);
   }
-  AteResult result;
-  if (align) result.alignment = AlignRigid(from, to);
-  std::vector<double> errors;
-  double sum = 0.0, sum_sq = 0.0;
-  for (size_t k = 0; k < from.size(); ++k) {
-    const double e = (result.alignment.Apply(from[k]) - to[k]).norm();
-    errors.push_back(e);
-    sum += e;
-    sum_sq += e * e;
-    result.max_m = std::max(result.max_m, e);
-  }
-  const double n = static_cast<double>(errors.size());
-  result.pairs = static_cast<int>(errors.size());
-  result.rmse_m = std::sqrt(sum_sq / n);
-  result.mean_m = sum / n;
-  std::sort(errors.begin(), errors.end());
-  const size_t mid = errors.size() / 2;
-  result.median_m = errors.size() % 2 ? errors[mid] : 0.5 * (errors[mid - 1] + errors[mid]);
-  return result;
+  return PairedTrajectoryError(to, from, align);
 }
 
 LandmarkError LandmarkRmse(const std::vector<LandmarkPoint>& truth,

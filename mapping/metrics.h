@@ -38,9 +38,10 @@ struct Rigid2d {
 };
 
 // TUM RGB-D trajectory: one line `timestamp tx ty tz qx qy qz qw` per pose, z = 0 and the
-// quaternion a rotation about z by theta. Throws std::runtime_error if the file cannot be
-// written.
-void WriteTumTrajectory(const std::string& path, const std::vector<TimedPose>& poses);
+// quaternion a rotation about z by theta, after a header comment that names `what` the poses
+// are when it is given. Throws std::runtime_error if the file cannot be written.
+void WriteTumTrajectory(const std::string& path, const std::vector<TimedPose>& poses,
+                        const std::string& what = "");
 // Reads a TUM trajectory (`#` comments and blank lines allowed); the heading is the yaw of the
 // quaternion. Errors name the file and the line.
 std::vector<TimedPose> ReadTumTrajectory(const std::string& path);
@@ -66,8 +67,15 @@ struct AteResult {
   Rigid2d alignment;  // estimate -> truth frame (identity without alignment)
 };
 
-// Absolute trajectory error of `estimate` against `truth`. Throws std::invalid_argument when
-// no timestamps associate.
+// The error of estimated positions paired with true ones (truth[k] with estimate[k]: taken at
+// the same instants), after the rigid alignment of the estimates onto the truth when `align`.
+// Throws std::invalid_argument when there are no pairs or the two differ in length.
+AteResult PairedTrajectoryError(const std::vector<Eigen::Vector2d>& truth,
+                                const std::vector<Eigen::Vector2d>& estimate, bool align);
+
+// Absolute trajectory error of `estimate` against `truth`: poses associated by time
+// (AssociateByTime), then PairedTrajectoryError. Throws std::invalid_argument when no
+// timestamps associate.
 AteResult AbsoluteTrajectoryError(const std::vector<TimedPose>& truth,
                                   const std::vector<TimedPose>& estimate, double max_dt_s = 0.02,
                                   bool align = true);

@@ -143,14 +143,7 @@ MatchResult RunRecording(const field::SeasonConfig& season, const field::RobotCo
   slam.UpdateMaps();
   if (!out_dir.empty()) slam.object_map().WriteBinary(out_dir + "/objects.bt");
 
-  if (has_truth && !result.samples.empty()) {
-    double sum_sq = 0.0;
-    for (const PoseSample& s : result.samples)
-      sum_sq += (s.estimate - s.truth).head<2>().squaredNorm();
-    result.pose_ate_m = std::sqrt(sum_sq / result.samples.size());
-  } else {
-    result.pose_ate_m = std::numeric_limits<double>::quiet_NaN();
-  }
+  result.pose_ate_m = PoseAte(result.samples);
   for (int i = 0; i < slam.ekf().landmark_count(); ++i) {
     result.landmark_estimates.push_back(slam.ekf().landmark(i));
     result.landmark_covariances.push_back(slam.ekf().landmark_covariance(i));

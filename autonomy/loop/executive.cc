@@ -190,15 +190,7 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
   result.points = world.Points().value_or(0);
   result.overrun_s = world.overrun_s();
   result.duration_s = std::min(world.last_motion_s(), world.deadline_s() + result.overrun_s);
-  double sum_sq = 0.0;
-  int with_truth = 0;
-  for (const PoseSample& s : world.samples()) {
-    if (!s.truth_known) continue;
-    sum_sq += (s.estimate - s.truth).head<2>().squaredNorm();
-    ++with_truth;
-  }
-  result.pose_ate_m =
-      with_truth == 0 ? std::numeric_limits<double>::quiet_NaN() : std::sqrt(sum_sq / with_truth);
+  result.pose_ate_m = PoseAte(world.samples());
   result.frames_taken = world.frames();
   result.replans = world.replans();
   result.relocalisations = world.relocalisations();

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
 
+#include "mapping/metrics.h"
 #include "platform/field_geometry.h"
 
 namespace slamo::autonomy {
@@ -46,6 +48,17 @@ field::RobotConfig MatchRobot(const field::RobotConfig& robot, double speed_mps)
 }
 
 }  // namespace
+
+double PoseAte(const std::vector<PoseSample>& samples) {
+  std::vector<Eigen::Vector2d> truth, estimate;
+  for (const PoseSample& s : samples) {
+    if (!s.truth_known) continue;
+    truth.push_back(s.truth.head<2>());
+    estimate.push_back(s.estimate.head<2>());
+  }
+  if (truth.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return mapping::PairedTrajectoryError(truth, estimate, /*align=*/false).rmse_m;
+}
 
 mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
                             const platform::Pose2D& start, bool relocalise) {

@@ -83,6 +83,10 @@ struct PoseSample {
   bool truth_known = true;  // false on hardware (truth is then zero)
 };
 
+// The pose ATE over the samples whose truth is known: the RMS position error at the same
+// instants, without alignment (mapping::PairedTrajectoryError); NaN when none is.
+double PoseAte(const std::vector<PoseSample>& samples);
+
 class MatchWorld {
  public:
   // On `io` (the robot), the season's objects where its file puts them; `seed` seeds the

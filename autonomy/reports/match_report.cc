@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "autonomy/reports/field_picture.h"
+#include "mapping/metrics.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -148,16 +149,12 @@ nlohmann::json ReportJson(const MatchResult& r) {
 
 namespace {
 void WriteTumPoses(const MatchResult& result, const std::string& path, bool truth) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
-  out << "# " << (truth ? "ground truth" : "SLAM-O estimate")
-      << ": timestamp tx ty tz qx qy qz qw\n";
-  out << std::fixed << std::setprecision(6);
+  std::vector<mapping::TimedPose> poses;
   for (const PoseSample& s : result.samples) {
     const Eigen::Vector3d& p = truth ? s.truth : s.estimate;
-    out << s.t_s << ' ' << p.x() << ' ' << p.y() << " 0 0 0 " << std::sin(p.z() / 2) << ' '
-        << std::cos(p.z() / 2) << '\n';
+    poses.push_back({s.t_s, p.x(), p.y(), p.z()});
   }
+  mapping::WriteTumTrajectory(path, poses, truth ? "ground truth" : "SLAM-O estimate");
 }
 }  // namespace
 
