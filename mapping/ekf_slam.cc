@@ -101,8 +101,9 @@ void EkfSlam::Predict(const OdometryStep& u) {
   x_.head<3>() = Move(x_.head<3>(), u, &f_pose, &f_u);
   // P = F P F^T + G Q G^T, touching only the pose rows and columns.
   const int n = static_cast<int>(x_.size());
+  const Eigen::Matrix3d q = u.covariance ? *u.covariance : MotionCovariance(u);
   p_.topLeftCorner<3, 3>() = f_pose * p_.topLeftCorner<3, 3>() * f_pose.transpose() +
-                             f_u * MotionCovariance(u) * f_u.transpose();
+                             f_u * (q_scale_ == 1.0 ? q : q * q_scale_) * f_u.transpose();
   if (n > 3) {
     p_.topRightCorner(3, n - 3) = f_pose * p_.topRightCorner(3, n - 3);
     p_.bottomLeftCorner(n - 3, 3) = p_.topRightCorner(3, n - 3).transpose();
@@ -158,7 +159,7 @@ double EkfSlam::Mahalanobis2(const RangeBearing& z, int index) const {
   return e.dot(s.ldlt().solve(e));
 }
 
-void EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
+double EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
   const int n = static_cast<int>(x_.size());
   const int j = 3 + 2 * index;
   Eigen::Matrix<double, 2, 3> h_pose;
@@ -183,6 +184,58 @@ void EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
   ikh.diagonal().array() += 1.0;
   p_ = ikh * p_ * ikh.transpose() + k * z.covariance * k.transpose();
   Symmetrise(&p_);
+  const double nis = e.dot(s.ldlt().solve(e));
+  counters_.nis_sum += nis;
+  ++counters_.nis_count;
+  RecordNis(nis);
+  return nis;
+}
+
+void EkfSlam::RecordNis(double nis) {
+  const AdaptiveOptions& a = options_.adaptive;
+  if (!a.enabled) return;
+  nis_window_.push_back(std::min(nis, a.nis_cap));
+  if (static_cast<int>(nis_window_.size()) < a.window) return;
+  double mean = 0.0;
+  for (double v : nis_window_) mean += v;
+  mean /= static_cast<double>(nis_window_.size());
+  const double upper = Chi2Quantile(0.975, 2 * a.window) / a.window;
+  if (mean > upper) {
+    // Innovations persistently larger than predicted: more process noise.
+    if (!in_episode_) ++counters_.adaptive_episodes;
+    in_episode_ = true;
+    q_scale_ = std::min(a.max_scale, q_scale_ * a.growth);
+  } else if (mean < 2.0 && q_scale_ > 1.0) {
+    // Smaller than expected: back towards the nominal noise.
+    q_scale_ = std::max(1.0, q_scale_ / a.growth);
+    if (q_scale_ == 1.0) in_episode_ = false;
+  }
+  nis_window_.clear();
+}
+
+void EkfSlam::WidenPose(double factor) {
+  const double f = std::sqrt(factor);
+  p_.topRows<3>() *= f;
+  p_.leftCols<3>() *= f;
+  Symmetrise(&p_);
+}
+
+UpdateOutcome EkfSlam::Count(UpdateOutcome outcome) {
+  switch (outcome) {
+    case UpdateOutcome::kUpdated:
+      ++counters_.updated;
+      break;
+    case UpdateOutcome::kAdded:
+      ++counters_.added;
+      break;
+    case UpdateOutcome::kAmbiguous:
+      ++counters_.ambiguous;
+      break;
+    case UpdateOutcome::kRejected:
+      ++counters_.rejected;
+      break;
+  }
+  return outcome;
 }
 
 int EkfSlam::AddLandmark(const RangeBearing& z) {
@@ -219,18 +272,37 @@ void EkfSlam::AddKnownLandmark(const Eigen::Vector2d& position, const Eigen::Mat
   signatures_.push_back(signature);
 }
 
-UpdateOutcome EkfSlam::Update(const RangeBearing& z) {
+UpdateOutcome EkfSlam::Update(const RangeBearing& z) { return Count(Associate(z)); }
+
+UpdateOutcome EkfSlam::Associate(const RangeBearing& z) {
   if (!(z.range_m > 0.0) || z.range_m > options_.max_range_m || !std::isfinite(z.bearing_rad)) {
     return UpdateOutcome::kRejected;
   }
   // Known id: that landmark, or a new one with that id.
   if (z.id >= 0) {
     for (int i = 0; i < landmark_count(); ++i) {
-      if (ids_[i] == z.id) {
-        if (Mahalanobis2(z, i) > options_.association.new_chi2) return UpdateOutcome::kRejected;
+      if (ids_[i] != z.id) continue;
+      const double d2 = Mahalanobis2(z, i);
+      if (d2 <= options_.association.new_chi2) {
         ApplyUpdate(z, i);
+        if (lost_) ++counters_.reacquired;
+        lost_ = false;
+        known_failures_ = 0;
         return UpdateOutcome::kUpdated;
       }
+      // A known landmark outside the gate: evidence that the belief is too narrow.
+      RecordNis(d2);
+      if (!options_.adaptive.enabled || ++known_failures_ < options_.adaptive.lost_after)
+        return UpdateOutcome::kRejected;
+      // Lost: widen the pose so that this innovation sits inside the gate, and pair again.
+      lost_ = true;
+      WidenPose(std::min(1e6, 2.0 * d2 / options_.association.gate_chi2));
+      if (Mahalanobis2(z, i) > options_.association.new_chi2) return UpdateOutcome::kRejected;
+      ApplyUpdate(z, i);
+      ++counters_.reacquired;
+      lost_ = false;
+      known_failures_ = 0;
+      return UpdateOutcome::kUpdated;
     }
     AddLandmark(z);
     return UpdateOutcome::kAdded;
@@ -341,7 +413,7 @@ std::vector<UpdateOutcome> EkfSlam::UpdateFrame(const std::vector<RangeBearing>&
     if (!(z.range_m > 0.0) || z.range_m > options_.max_range_m || !std::isfinite(z.bearing_rad))
       continue;
     if (z.id >= 0) {
-      out[i] = Update(z);
+      out[i] = Associate(z);
     } else if (pairing[i] >= 0) {
       ApplyUpdate(z, pairing[i]);
       out[i] = UpdateOutcome::kUpdated;
@@ -362,6 +434,7 @@ std::vector<UpdateOutcome> EkfSlam::UpdateFrame(const std::vector<RangeBearing>&
       out[i] = UpdateOutcome::kAdded;
     }
   }
+  for (UpdateOutcome o : out) Count(o);
   return out;
 }
 

@@ -10,8 +10,10 @@
 // (object_tracker.h).
 #pragma once
 
+#include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -20,9 +22,16 @@ namespace slamo::mapping {
 
 // Odometry increment in the robot frame at the start of the step.
 struct OdometryStep {
+  OdometryStep(double dx = 0.0, double dy = 0.0, double dtheta = 0.0,
+               std::optional<Eigen::Matrix3d> step_covariance = std::nullopt)
+      : dx_m(dx), dy_m(dy), dtheta_rad(dtheta), covariance(std::move(step_covariance)) {}
   double dx_m = 0.0;  // forward
   double dy_m = 0.0;  // left
   double dtheta_rad = 0.0;
+  // The increment's own covariance (dx, dy, dtheta), when the source gives one (an MRPT
+  // rawlog's CActionRobotMovement2D, a text log's odom line with sigmas); without it the
+  // filter's MotionNoise model stands in.
+  std::optional<Eigen::Matrix3d> covariance;
 };
 
 // Defaults: the thesis robot as simulated, measured over 300 seeds of `forward 0.3` and
@@ -54,8 +63,40 @@ struct AssociationOptions {
   double new_chi2 = 25.0;   // create a landmark only beyond this from every landmark
 };
 
+// The filter checking itself against what it observes. The normalised innovation squared
+// (NIS, e^T S^-1 e, 2 dof) of every measurement tried against a landmark is kept over a
+// sliding window. Covariance matching (Mehra 1972; the scaled-Q form of Sage and Husa's
+// adaptive filter): when the window's mean NIS lies above the 97.5 % bound of its chi-square
+// band the process noise is scaled up by `growth`, and scaled back towards 1 by the same
+// factor when the mean falls below its expectation (2). Lost and found: after `lost_after`
+// known-id measurements in a row fail the gate, the pose is widened (its rows and columns of P
+// scaled so that the failing innovation would sit inside the gate) and the measurement tried
+// again; a pairing then ends the lost state (re-acquired).
+struct AdaptiveOptions {
+  bool enabled = false;
+  int window = 20;         // measurements per NIS window
+  double growth = 2.0;     // process-noise scale factor per window outside the band
+  double max_scale = 1e3;  // the process noise is never scaled beyond this
+  int lost_after = 3;      // known-id gate failures in a row before the pose is widened
+  double nis_cap = 100.0;  // one measurement's NIS counts at most this much in the window
+};
+
+// What the filter did, over its life.
+struct FilterCounters {
+  int updated = 0;
+  int added = 0;
+  int ambiguous = 0;
+  int rejected = 0;
+  int reacquired = 0;         // updates that ended a lost state after the pose was widened
+  int adaptive_episodes = 0;  // times the process noise was raised from its nominal level
+  double nis_sum = 0.0;       // NIS of the measurements that updated the filter
+  int nis_count = 0;
+  double MeanNis() const { return nis_count ? nis_sum / nis_count : 0.0; }
+};
+
 struct EkfOptions {
   MotionNoise motion;
+  AdaptiveOptions adaptive;
   AssociationOptions association;
   double max_range_m = 4.5;  // measurements beyond this are ignored
   // false: the map is surveyed and complete; a measurement that pairs with no landmark is
@@ -71,7 +112,8 @@ class EkfSlam {
   EkfSlam(const Eigen::Vector3d& start_pose, const Eigen::Matrix3d& start_covariance,
           const EkfOptions& options = {});
 
-  // Prediction: X- = f(X+, u), P- = F P F^T + G Q G^T.
+  // Prediction: X- = f(X+, u), P- = F P F^T + G Q G^T, Q the step's own covariance when it
+  // has one, else the MotionNoise model; scaled by the adaptive process-noise factor.
   void Predict(const OdometryStep& u);
   // Update with one measurement (associating it, or adding a landmark).
   UpdateOutcome Update(const RangeBearing& z);
@@ -88,6 +130,11 @@ class EkfSlam {
   const Eigen::MatrixXd& covariance() const { return p_; }
   Eigen::Vector3d pose() const { return x_.head<3>(); }
   Eigen::Matrix3d pose_covariance() const { return p_.topLeftCorner<3, 3>(); }
+  const FilterCounters& counters() const { return counters_; }
+  const EkfOptions& options() const { return options_; }
+  // The process-noise scale now (1: nominal) and whether known markers keep failing the gate.
+  double process_noise_scale() const { return q_scale_; }
+  bool lost() const { return lost_; }
   int landmark_count() const { return static_cast<int>(ids_.size()); }
   Eigen::Vector2d landmark(int index) const { return x_.segment<2>(3 + 2 * index); }
   Eigen::Matrix2d landmark_covariance(int index) const {
@@ -120,14 +167,28 @@ class EkfSlam {
   double Mahalanobis2(const RangeBearing& z, int index) const;
 
  private:
-  void ApplyUpdate(const RangeBearing& z, int index);
+  // Update without counting the outcome (Update and UpdateFrame count).
+  UpdateOutcome Associate(const RangeBearing& z);
+  // Returns the measurement's NIS against the prediction.
+  double ApplyUpdate(const RangeBearing& z, int index);
   int AddLandmark(const RangeBearing& z);
+  // The adaptive scheme's bookkeeping for one measurement's NIS (AdaptiveOptions).
+  void RecordNis(double nis);
+  // Widens the pose by `factor` (its rows and columns of P by sqrt(factor)).
+  void WidenPose(double factor);
+  UpdateOutcome Count(UpdateOutcome outcome);
 
   EkfOptions options_;
   Eigen::VectorXd x_;
   Eigen::MatrixXd p_;
   std::vector<int> ids_;
   std::vector<std::string> signatures_;
+  FilterCounters counters_;
+  std::deque<double> nis_window_;
+  double q_scale_ = 1.0;
+  bool in_episode_ = false;
+  int known_failures_ = 0;  // known-id gate failures in a row
+  bool lost_ = false;
 };
 
 // Pose NEES (x - x_hat)^T P^-1 (x - x_hat), heading error wrapped.

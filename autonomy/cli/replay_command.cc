@@ -7,25 +7,182 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <sstream>
 #include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
 
 #include "autonomy/cli/commands.h"
 #include "mapping/ekf_slam.h"
 #include "mapping/metrics.h"
 #include "mapping/replay_log.h"
+#include "platform/drive_base.h"
 
 namespace slamo::autonomy {
 namespace {
+
+// The filter of another robot: what `--filter-config FILE` (YAML, the same names with
+// underscores) and the options below set. Unset values keep the log's own (sensor sigmas,
+// odometry covariance) or the filter's defaults.
+struct FilterArgs {
+  std::optional<double> motion_per_m;       // position sigma per metre travelled
+  std::optional<double> motion_per_rad;     // heading sigma per radian turned
+  std::optional<double> range_sigma_m;      // every measurement's range sigma
+  std::optional<double> bearing_sigma_deg;  // every measurement's bearing sigma
+  std::optional<double> max_range_m;
+  std::optional<double> fov_deg;                   // measurements beyond +-fov/2 are dropped
+  std::optional<double> gate_probability;          // of the association gate, 2 dof
+  std::optional<bool> known_ids;                   // false: associate every measurement by position
+  std::optional<std::string> odometry_covariance;  // log | model
+  std::optional<bool> adaptive;
+};
 
 struct ReplayArgs {
   std::string log;
   std::string truth;
   std::string landmarks_truth;
   std::string out;
+  std::string filter_config;
   double max_dt_s = 0.02;
   double start_sigma_m = 1e-3;
   double start_sigma_rad = 1e-3;
+  FilterArgs filter;
 };
+
+// A bad filter value: the message names the option (or the file and key).
+struct FilterError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+void CheckRange(const std::string& name, const std::optional<double>& v, double lo, double hi,
+                bool lo_open = true) {
+  if (!v) return;
+  if (!std::isfinite(*v) || (lo_open ? *v <= lo : *v < lo) || *v > hi) {
+    std::ostringstream out;
+    out << name << ": expected a number in " << (lo_open ? "(" : "[") << lo << ", " << hi
+        << "], got " << *v;
+    throw FilterError(out.str());
+  }
+}
+
+// Reads --filter-config into `filter`, keeping what the command line set.
+void ReadFilterConfig(const std::string& path, FilterArgs* filter) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw FilterError(path + ": " + e.what());
+  }
+  if (!root.IsMap()) throw FilterError(path + ": expected a map of filter options");
+  for (const auto& item : root) {
+    const std::string key = item.first.as<std::string>();
+    const YAML::Node& v = item.second;
+    const std::string where = path + ":" + std::to_string(v.Mark().line + 1) + ": " + key;
+    try {
+      const auto number = [&](std::optional<double>* out) {
+        if (!*out) *out = v.as<double>();
+      };
+      if (key == "motion_per_m")
+        number(&filter->motion_per_m);
+      else if (key == "motion_per_rad")
+        number(&filter->motion_per_rad);
+      else if (key == "range_sigma_m")
+        number(&filter->range_sigma_m);
+      else if (key == "bearing_sigma_deg")
+        number(&filter->bearing_sigma_deg);
+      else if (key == "max_range_m")
+        number(&filter->max_range_m);
+      else if (key == "fov_deg")
+        number(&filter->fov_deg);
+      else if (key == "gate_probability")
+        number(&filter->gate_probability);
+      else if (key == "known_ids") {
+        if (!filter->known_ids) filter->known_ids = v.as<bool>();
+      } else if (key == "odometry_covariance") {
+        if (!filter->odometry_covariance) filter->odometry_covariance = v.as<std::string>();
+      } else if (key == "adaptive") {
+        if (!filter->adaptive) filter->adaptive = v.as<bool>();
+      } else {
+        throw FilterError(where +
+                          ": unknown key; expected motion_per_m, motion_per_rad, "
+                          "range_sigma_m, bearing_sigma_deg, max_range_m, fov_deg, "
+                          "gate_probability, known_ids, odometry_covariance or adaptive");
+      }
+    } catch (const YAML::Exception&) {
+      throw FilterError(where + ": expected " +
+                        (key == "known_ids" || key == "adaptive" ? "true or false"
+                         : key == "odometry_covariance"          ? "log or model"
+                                                                 : "a number"));
+    }
+  }
+}
+
+// Every value in its range; the option names in the messages are the command line's.
+void CheckFilter(const FilterArgs& f) {
+  CheckRange("--motion-per-m", f.motion_per_m, 0.0, 10.0);
+  CheckRange("--motion-per-rad", f.motion_per_rad, 0.0, 10.0);
+  CheckRange("--range-sigma", f.range_sigma_m, 0.0, 100.0);
+  CheckRange("--bearing-sigma-deg", f.bearing_sigma_deg, 0.0, 180.0);
+  CheckRange("--max-range", f.max_range_m, 0.0, 1e6);
+  CheckRange("--fov-deg", f.fov_deg, 0.0, 360.0);
+  CheckRange("--gate-prob", f.gate_probability, 0.5, 0.999999);
+  if (f.gate_probability && *f.gate_probability >= 1.0)
+    throw FilterError("--gate-prob: expected a probability below 1");
+  if (f.odometry_covariance && *f.odometry_covariance != "log" &&
+      *f.odometry_covariance != "model") {
+    throw FilterError("--odometry-covariance: expected log or model, got " +
+                      *f.odometry_covariance);
+  }
+}
+
+// The filter's options from the arguments (defaults where unset).
+mapping::EkfOptions FilterOptions(const FilterArgs& f) {
+  mapping::EkfOptions options;
+  options.adaptive.enabled = f.adaptive.value_or(true);
+  if (f.motion_per_m) {
+    options.motion.sigma_per_m = *f.motion_per_m;
+    options.motion.lateral_sigma_per_m = *f.motion_per_m;
+  }
+  if (f.motion_per_rad) {
+    options.motion.heading_sigma_per_rad = *f.motion_per_rad;
+    options.motion.forward_sigma_per_rad = 0.0;
+    options.motion.lateral_sigma_per_rad = 0.0;
+  }
+  if (f.max_range_m) options.max_range_m = *f.max_range_m;
+  if (f.gate_probability) {
+    // Chi-square with 2 dof: P(d2 < g) = 1 - exp(-g / 2).
+    options.association.gate_chi2 = -2.0 * std::log(1.0 - *f.gate_probability);
+    options.association.new_chi2 =
+        std::max(options.association.new_chi2, options.association.gate_chi2 * 25.0 / 9.21);
+  }
+  return options;
+}
+
+// The log as the arguments ask for it: measurement sigmas set, ids dropped, the field of view
+// applied, the odometry's own covariance kept or dropped.
+void ApplyFilterArgs(const FilterArgs& f, mapping::ReplayLog* log) {
+  const double half_fov = f.fov_deg ? *f.fov_deg / 2.0 * platform::kPi / 180.0 : 10.0;
+  std::vector<mapping::LogEvent> kept;
+  for (mapping::LogEvent& e : log->events) {
+    if (e.is_odometry()) {
+      if (f.odometry_covariance.value_or("log") == "model")
+        std::get<mapping::OdometryStep>(e.data).covariance.reset();
+    } else {
+      auto& z = std::get<mapping::RangeBearing>(e.data);
+      if (std::abs(z.bearing_rad) > half_fov) continue;
+      if (f.range_sigma_m) z.covariance(0, 0) = *f.range_sigma_m * *f.range_sigma_m;
+      if (f.bearing_sigma_deg) {
+        const double sb = *f.bearing_sigma_deg * platform::kPi / 180.0;
+        z.covariance(1, 1) = sb * sb;
+      }
+      if (f.range_sigma_m || f.bearing_sigma_deg) z.covariance(0, 1) = z.covariance(1, 0) = 0.0;
+      if (!f.known_ids.value_or(true)) z.id = -1;
+    }
+    kept.push_back(std::move(e));
+  }
+  log->events = std::move(kept);
+}
 
 void WriteLandmarks(const std::string& path, const mapping::EkfSlam& ekf) {
   std::ofstream out(path);
@@ -42,8 +199,17 @@ void WriteLandmarks(const std::string& path, const mapping::EkfSlam& ekf) {
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
-int Run(const ReplayArgs& args) {
-  const mapping::ReplayLog log = mapping::ReadReplayLog(args.log);
+int Run(const ReplayArgs& cli) {
+  ReplayArgs args = cli;
+  try {
+    if (!args.filter_config.empty()) ReadFilterConfig(args.filter_config, &args.filter);
+    CheckFilter(args.filter);
+  } catch (const FilterError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  mapping::ReplayLog log = mapping::ReadReplayLog(args.log);
+  ApplyFilterArgs(args.filter, &log);
 
   // Start where the log says (a `start` line), else at the origin; the small covariance
   // anchors the map frame to the start pose.
@@ -53,12 +219,11 @@ int Run(const ReplayArgs& args) {
                       args.start_sigma_m * args.start_sigma_m,
                       args.start_sigma_rad * args.start_sigma_rad)
           .asDiagonal();
-  mapping::EkfSlam ekf(start, start_covariance);
+  mapping::EkfSlam ekf(start, start_covariance, FilterOptions(args.filter));
 
   // Predict on odometry, update on measurements; one pose per odometry step.
   std::vector<mapping::TimedPose> trajectory;
-  int outcomes[4] = {0, 0, 0, 0};
-  int measurements = 0;
+  int measurements = 0, known = 0, known_rejected = 0;
   for (const mapping::LogEvent& e : log.events) {
     if (e.is_odometry()) {
       ekf.Predict(e.odometry());
@@ -66,16 +231,26 @@ int Run(const ReplayArgs& args) {
       trajectory.push_back({e.t_s, pose.x(), pose.y(), pose.z()});
     } else {
       ++measurements;
-      ++outcomes[static_cast<int>(ekf.Update(e.measurement()))];
+      const mapping::UpdateOutcome o = ekf.Update(e.measurement());
+      if (e.measurement().id >= 0) {
+        ++known;
+        known_rejected += o == mapping::UpdateOutcome::kRejected;
+      }
     }
   }
   const Eigen::Vector3d pose = ekf.pose();
   const Eigen::Matrix3d pose_covariance = ekf.pose_covariance();
+  const mapping::FilterCounters& c = ekf.counters();
   std::printf(
       "%s: %zu odometry steps, %d measurements (%d updated, %d added, %d ambiguous, %d "
-      "rejected)\n",
-      args.log.c_str(), trajectory.size(), measurements, outcomes[0], outcomes[1], outcomes[2],
-      outcomes[3]);
+      "rejected; known ids: %d, %d rejected, %.1f %%)\n",
+      args.log.c_str(), trajectory.size(), measurements, c.updated, c.added, c.ambiguous,
+      c.rejected, known, known_rejected, known ? 100.0 * known_rejected / known : 0.0);
+  std::printf(
+      "filter: %s; re-acquired %d, adaptive-noise episodes %d, process-noise scale now %.3g, "
+      "mean NIS %.2f (2 expected)\n",
+      ekf.options().adaptive.enabled ? "adaptive" : "fixed noise", c.reacquired,
+      c.adaptive_episodes, ekf.process_noise_scale(), c.MeanNis());
   std::printf(
       "final pose (%.3f m, %.3f m, %.1f deg), sigma (%.3f m, %.3f m, %.2f deg); %d "
       "landmarks\n",
@@ -143,6 +318,49 @@ void RegisterReplayCommand(CLI::App& app, CommandAction* action) {
       ->capture_default_str();
   replay->add_option("--start-sigma-rad", args->start_sigma_rad, "start heading sigma, rad")
       ->capture_default_str();
+  // The filter of another robot (bad values exit 2 naming the option).
+  FilterArgs* f = &args->filter;
+  replay->add_option("--filter-config", args->filter_config,
+                     "YAML file of the options below (motion_per_m: 0.1, known_ids: false, ...); "
+                     "the command line wins");
+  replay->add_option("--motion-per-m", f->motion_per_m,
+                     "odometry model: position sigma per metre travelled (default: the log's "
+                     "own odometry covariance where it has one, else the thesis robot's 0.175)");
+  replay->add_option("--motion-per-rad", f->motion_per_rad,
+                     "odometry model: heading sigma per radian turned (thesis robot: 0.025)");
+  replay->add_option("--range-sigma", f->range_sigma_m,
+                     "every measurement's range sigma, m (default: the log's)");
+  replay->add_option("--bearing-sigma-deg", f->bearing_sigma_deg,
+                     "every measurement's bearing sigma, degrees (default: the log's)");
+  replay->add_option("--max-range", f->max_range_m,
+                     "measurements beyond this are ignored, m "
+                     "(default 4.5)");
+  replay->add_option("--fov-deg", f->fov_deg,
+                     "field of view: measurements beyond +-fov/2 are dropped (default: all)");
+  replay->add_option("--gate-prob", f->gate_probability,
+                     "association gate probability, 2 dof (default 0.99: chi2 9.21)");
+  replay
+      ->add_option("--known-ids", f->known_ids,
+                   "true: measured ids name the landmark; false: associate by position")
+      ->default_str("true");
+  replay
+      ->add_option("--odometry-covariance", f->odometry_covariance,
+                   "log: each step's own covariance where the log has one (an MRPT action's "
+                   "pose PDF, MRPT's own EKF does the same); model: the motion model's")
+      ->default_str("log");
+  replay
+      ->add_option("--adaptive", f->adaptive,
+                   "true: the filter raises its process noise when innovations stay larger "
+                   "than predicted and widens a lost pose; false: fixed noise")
+      ->default_str("true");
+  replay->footer(
+      "Examples:\n"
+      "  slamo replay --log run.rawlog --truth t.tum --landmarks-truth l.csv\n"
+      "  slamo replay --log run.rawlog --motion-per-m 0.3 --range-sigma 0.05 --known-ids false\n"
+      "  slamo replay --log run.log --filter-config robot.yaml --out DIR\n"
+      "  robot.yaml:  motion_per_m: 0.3\n"
+      "               bearing_sigma_deg: 1.0\n"
+      "               gate_probability: 0.999\n");
   replay->callback([args, action] {
     *action = [args] {
       try {
