@@ -7,16 +7,15 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 #include <mrpt/core/Clock.h>
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationBearingRange.h>
 #include <mrpt/obs/CObservationOdometry.h>
-#include <mrpt/obs/CRawlog.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/poses/CPose3D.h>
@@ -24,6 +23,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include "platform/rawlog_guard.h"
+#include "platform/rawlog_reader.h"
 
 namespace slamo::mapping {
 namespace {
@@ -167,31 +167,17 @@ class RawlogReader {
 
   ReplayLog Read() {
     if (!std::ifstream(path_)) throw ReplayLogError(path_ + ": cannot open");
-    // A record that crashes or hangs MRPT's deserialiser does so in a child process.
-    if (const std::optional<std::string> crash = platform::CheckRawlogInChildProcess(path_))
-      throw ReplayLogError(path_ + ": " + *crash + ": not a rawlog slamo can read");
-    mrpt::io::CFileGZInputStream file;
     try {
-      if (!file.open(path_)) throw ReplayLogError(path_ + ": cannot open");
-    } catch (const ReplayLogError&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw ReplayLogError(path_ + ": cannot open (" + platform::MrptErrorGist(e.what()) + ")");
-    }
-    auto archive = mrpt::serialization::archiveFrom(file);
-    for (record_ = 1;; ++record_) {
-      const uint64_t before = file.getPosition();
-      mrpt::serialization::CSerializable::Ptr object;
-      try {
-        object = archive.ReadObject();
-      } catch (const mrpt::serialization::CExceptionEOF&) {
-        if (file.getPosition() == before) break;  // a clean end between records
-        throw Error("truncated (the file ends inside it)");
-      } catch (const std::exception& e) {
-        throw Error("not a valid MRPT rawlog record (" + platform::MrptErrorGist(e.what()) + ")");
+      records_ = std::make_unique<platform::RawlogRecords>(path_);
+      while (const std::optional<platform::RawlogEntry> entry = records_->Next()) {
+        if (entry->actions) {
+          AddActions(*entry->actions);
+        } else {
+          AddObservation(*entry->observation);
+        }
       }
-      if (!object) throw Error("an empty (null) object");
-      Add(*object);
+    } catch (const platform::RawlogError& e) {
+      throw ReplayLogError(e.what());
     }
     // Records carry their own stamps; put the events in time order.
     std::stable_sort(log_.events.begin(), log_.events.end(),
@@ -201,7 +187,7 @@ class RawlogReader {
 
  private:
   ReplayLogError Error(const std::string& what) const {
-    return ReplayLogError(path_ + ": record " + std::to_string(record_) + ": " + what);
+    return ReplayLogError(records_->Where(what));
   }
 
   // A stamp, or the last one seen when it is missing.
@@ -210,25 +196,13 @@ class RawlogReader {
     return last_t_;
   }
 
-  void Add(const mrpt::serialization::CSerializable& object) {
-    using namespace mrpt::obs;  // NOLINT(build/namespaces): the MRPT classes, briefly
-    if (const auto* actions = dynamic_cast<const CActionCollection*>(&object)) {
-      // The actions of one collection are alternative estimates of one motion: take the first.
-      for (const auto& action : *actions) {
-        if (const auto* move = dynamic_cast<const CActionRobotMovement2D*>(action.get())) {
-          AddMovement(*move);
-          break;
-        }
+  // The actions of one collection are alternative estimates of one motion: take the first.
+  void AddActions(const mrpt::obs::CActionCollection& actions) {
+    for (const auto& action : actions) {
+      if (const auto* move = dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(action.get())) {
+        AddMovement(*move);
+        break;
       }
-    } else if (const auto* frame = dynamic_cast<const CSensoryFrame*>(&object)) {
-      for (const auto& observation : *frame) AddObservation(*observation);
-    } else if (const auto* observation = dynamic_cast<const CObservation*>(&object)) {
-      AddObservation(*observation);
-    } else if (const auto* rawlog = dynamic_cast<const CRawlog*>(&object)) {
-      for (const auto& entry : *rawlog) Add(*entry);
-    } else {
-      throw Error(std::string("a ") + object.GetRuntimeClass()->className +
-                  ", not an action collection, sensory frame or observation: not a rawlog");
     }
   }
 
@@ -299,7 +273,7 @@ class RawlogReader {
 
   std::string path_;
   ReplayLogOptions options_;
-  int record_ = 0;
+  std::unique_ptr<platform::RawlogRecords> records_;
   double last_t_ = 0.0;
   std::optional<mrpt::poses::CPose2D> last_odometry_;
   ReplayLog log_;

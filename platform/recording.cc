@@ -8,21 +8,18 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <utility>
 
 #include <mrpt/core/Clock.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/img/TCamera.h>
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
-#include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CObservationRobotPose.h>
-#include <mrpt/obs/CRawlog.h>
-#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/poses/CPose3D.h>
 #include <mrpt/serialization/CArchive.h>
@@ -33,6 +30,7 @@
 
 #include "platform/clock.h"
 #include "platform/rawlog_guard.h"
+#include "platform/rawlog_reader.h"
 
 namespace slamo::platform {
 namespace {
@@ -689,74 +687,38 @@ class TumReader : public RecordingReader {
 
 // ---- MRPT rawlog: reader ----
 
-// Reads a rawlog's records in order and hands out their observations (sensory frames and
-// nested rawlogs flattened; actions skipped).
+// A recording rawlog's observations in order (rawlog_reader.h flattens the records; actions
+// are skipped: odometry increments as actions are not part of a recording's data).
 class RawlogStream {
  public:
-  explicit RawlogStream(const std::string& path) : path_(path) {
+  explicit RawlogStream(const std::string& path) {
     std::error_code ec;
-    if (!fs::is_regular_file(path_, ec)) throw RecordingError(path_ + ": no such file");
-    // A record that crashes or hangs MRPT's deserialiser does so in a child process.
-    if (const std::optional<std::string> crash = CheckRawlogInChildProcess(path_))
-      throw RecordingError(path_ + ": " + *crash + ": not a rawlog slamo can read");
-    bool ok = false;
+    if (!fs::is_regular_file(path, ec)) throw RecordingError(path + ": no such file");
     try {
-      ok = file_.open(path_);
-    } catch (const std::exception& e) {
-      throw RecordingError(path_ + ": cannot open (" + MrptErrorGist(e.what()) + ")");
+      records_ = std::make_unique<RawlogRecords>(path);
+    } catch (const RawlogError& e) {
+      throw RecordingError(e.what());
     }
-    if (!ok) throw RecordingError(path_ + ": cannot open");
-    archive_ = mrpt::serialization::archiveUniquePtrFrom(file_);
   }
 
   // The next observation, or null at the end of the file.
-  mrpt::obs::CObservation::Ptr Next() {
-    while (pending_.empty()) {
-      ++record_;
-      const uint64_t before = file_.getPosition();
-      mrpt::serialization::CSerializable::Ptr object;
-      try {
-        object = archive_->ReadObject();
-      } catch (const mrpt::serialization::CExceptionEOF&) {
-        if (file_.getPosition() == before) return nullptr;  // a clean end between records
-        throw Error("truncated (the file ends inside it)");
-      } catch (const std::exception& e) {
-        throw Error("not a valid MRPT rawlog record (" + MrptErrorGist(e.what()) + ")");
+  std::shared_ptr<const mrpt::obs::CObservation> Next() {
+    try {
+      while (const std::optional<RawlogEntry> entry = records_->Next()) {
+        if (entry->observation) return entry->observation;
       }
-      if (!object) throw Error("an empty (null) object");
-      Add(object);
+    } catch (const RawlogError& e) {
+      throw RecordingError(e.what());
     }
-    mrpt::obs::CObservation::Ptr next = pending_.front();
-    pending_.erase(pending_.begin());
-    return next;
+    return nullptr;
   }
 
   RecordingError Error(const std::string& what) const {
-    return RecordingError(path_ + ": record " + std::to_string(record_) + ": " + what);
+    return RecordingError(records_->Where(what));
   }
 
  private:
-  void Add(const mrpt::serialization::CSerializable::Ptr& object) {
-    using namespace mrpt::obs;  // NOLINT(build/namespaces): the MRPT classes, briefly
-    if (auto observation = std::dynamic_pointer_cast<CObservation>(object)) {
-      pending_.push_back(observation);
-    } else if (const auto* frame = dynamic_cast<const CSensoryFrame*>(object.get())) {
-      for (const auto& o : *frame) pending_.push_back(o);
-    } else if (dynamic_cast<const CActionCollection*>(object.get())) {
-      // Odometry increments as actions: not part of a recording's data.
-    } else if (const auto* rawlog = dynamic_cast<const CRawlog*>(object.get())) {
-      for (const auto& entry : *rawlog) Add(entry);
-    } else {
-      throw Error(std::string("a ") + object->GetRuntimeClass()->className +
-                  ", not an observation, sensory frame or action collection: not a rawlog");
-    }
-  }
-
-  std::string path_;
-  mrpt::io::CFileGZInputStream file_;
-  mrpt::serialization::CArchive::UniquePtr archive_;
-  std::vector<mrpt::obs::CObservation::Ptr> pending_;
-  int record_ = 0;
+  std::unique_ptr<RawlogRecords> records_;
 };
 
 double Seconds(mrpt::Clock::time_point t) { return mrpt::Clock::toDouble(t); }
@@ -820,7 +782,7 @@ class RawlogReader : public RecordingReader {
     RawlogStream stream(path);
     bool have_info = false;
     double last_frame_t = 0.0;
-    while (const mrpt::obs::CObservation::Ptr o = stream.Next()) {
+    while (const std::shared_ptr<const mrpt::obs::CObservation> o = stream.Next()) {
       if (const auto* comment = dynamic_cast<const mrpt::obs::CObservationComment*>(o.get())) {
         if (have_info) continue;
         const nlohmann::json j = nlohmann::json::parse(comment->text, nullptr, false);
@@ -877,7 +839,7 @@ class RawlogReader : public RecordingReader {
 
   std::optional<RgbdFrame> Grab() override {
     if (next_index_ >= static_cast<int64_t>(frame_count_)) return std::nullopt;
-    while (const mrpt::obs::CObservation::Ptr o = frames_->Next()) {
+    while (const std::shared_ptr<const mrpt::obs::CObservation> o = frames_->Next()) {
       if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(o.get())) {
         RgbdFrame frame = ToFrame(*scan, *frames_);
         frame.index = next_index_++;
