@@ -87,7 +87,10 @@ Eigen::Vector3d EkfSlam::Move(const Eigen::Vector3d& pose, const OdometryStep& u
 }
 
 Eigen::Matrix3d EkfSlam::MotionCovariance(const OdometryStep& u) const {
-  const MotionNoise& m = options_.motion;
+  return MotionModelCovariance(options_.motion, u);
+}
+
+Eigen::Matrix3d MotionModelCovariance(const MotionNoise& m, const OdometryStep& u) {
   const double distance = std::hypot(u.dx_m, u.dy_m);
   const double turn = std::abs(u.dtheta_rad);
   const double sx = m.sigma_per_m * distance + m.forward_sigma_per_rad * turn + m.floor_m;

@@ -49,6 +49,10 @@ struct MotionNoise {
   double floor_rad = 1e-4;
 };
 
+// The covariance of the increment `u` (dx, dy, dtheta) under the motion model `noise`: sigmas
+// growing with the distance travelled and the angle turned.
+Eigen::Matrix3d MotionModelCovariance(const MotionNoise& noise, const OdometryStep& u);
+
 // One range-bearing measurement from the robot centre, with its covariance (vision's).
 struct RangeBearing {
   double range_m = 0.0;

@@ -106,7 +106,9 @@ class TextLogReader {
   }
 
   void ReadOdometry() {
-    ExpectFields({4, 5}, "odom <t_s> <v_mps> <w_radps>` or `odom <t_s> <dx_m> <dy_m> <dtheta_rad>");
+    ExpectFields({4, 5, 8},
+                 "odom <t_s> <v_mps> <w_radps>` or `odom <t_s> <dx_m> <dy_m> <dtheta_rad> "
+                 "[<sigma_dx_m> <sigma_dy_m> <sigma_dtheta_rad>]");
     const double t = Time();
     OdometryStep step;
     if (fields_.size() == 4) {
@@ -118,6 +120,12 @@ class TextLogReader {
       step.dx_m = Number(2, "dx_m");
       step.dy_m = Number(3, "dy_m");
       step.dtheta_rad = Number(4, "dtheta_rad");
+    }
+    if (fields_.size() == 8) {
+      const double sx = Number(5, "sigma_dx_m"), sy = Number(6, "sigma_dy_m"),
+                   st = Number(7, "sigma_dtheta_rad");
+      if (!(sx > 0.0 && sy > 0.0 && st > 0.0)) throw Error("odometry sigmas must be > 0");
+      step.covariance = Eigen::Vector3d(sx * sx, sy * sy, st * st).asDiagonal();
     }
     last_odometry_t_ = t;
     log_.events.push_back({t, step});
@@ -206,18 +214,29 @@ class RawlogReader {
     }
   }
 
+  // The movement's mean and, as MRPT's own EKF uses it, its pose PDF's covariance.
   void AddMovement(const mrpt::obs::CActionRobotMovement2D& move) {
     if (!move.poseChange) throw Error("a robot movement without a pose change");
-    AddStep(move.timestamp, move.poseChange->getMeanVal());
+    mrpt::math::CMatrixDouble33 c;
+    mrpt::poses::CPose2D mean;
+    move.poseChange->getCovarianceAndMean(c, mean);
+    Eigen::Matrix3d covariance;
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) covariance(r, k) = c(r, k);
+    if (!covariance.allFinite() || (covariance.diagonal().array() < 0.0).any()) {
+      throw Error("a robot movement whose covariance is not finite or has a negative variance");
+    }
+    AddStep(move.timestamp, mean, 0.5 * (covariance + covariance.transpose()));
   }
 
-  void AddStep(mrpt::Clock::time_point t, const mrpt::poses::CPose2D& d) {
+  void AddStep(mrpt::Clock::time_point t, const mrpt::poses::CPose2D& d,
+               std::optional<Eigen::Matrix3d> covariance = std::nullopt) {
     if (!std::isfinite(d.x()) || !std::isfinite(d.y()) || !std::isfinite(d.phi())) {
       throw Error("an odometry step that is not finite");
     }
     LogEvent event;
     event.t_s = Stamp(t);
-    event.data = OdometryStep{d.x(), d.y(), d.phi()};
+    event.data = OdometryStep{d.x(), d.y(), d.phi(), std::move(covariance)};
     log_.events.push_back(std::move(event));
   }
 
@@ -240,6 +259,10 @@ class RawlogReader {
   // are taken as zero (a planar robot).
   void AddBearingRange(const mrpt::obs::CObservationBearingRange& o) {
     const double t = Stamp(o.timestamp);
+    if (std::isfinite(o.maxSensorDistance) && o.maxSensorDistance > 0.0) {
+      log_.sensor_max_range_m =
+          std::max(log_.sensor_max_range_m.value_or(0.0), double{o.maxSensorDistance});
+    }
     const mrpt::poses::CPose3D& sensor = o.sensorLocationOnRobot;
     for (const auto& m : o.sensedData) {
       const double r = m.range * std::cos(m.pitch);
@@ -304,8 +327,14 @@ void WriteTextLog(const std::string& path, const ReplayLog& log) {
   for (const LogEvent& e : log.events) {
     if (e.is_odometry()) {
       const OdometryStep& u = e.odometry();
-      std::snprintf(line, sizeof(line), "odom %.9f %.12g %.12g %.12g\n", e.t_s, u.dx_m, u.dy_m,
-                    u.dtheta_rad);
+      if (u.covariance) {
+        const Eigen::Vector3d sigma = u.covariance->diagonal().cwiseSqrt();
+        std::snprintf(line, sizeof(line), "odom %.9f %.12g %.12g %.12g %.12g %.12g %.12g\n", e.t_s,
+                      u.dx_m, u.dy_m, u.dtheta_rad, sigma.x(), sigma.y(), sigma.z());
+      } else {
+        std::snprintf(line, sizeof(line), "odom %.9f %.12g %.12g %.12g\n", e.t_s, u.dx_m, u.dy_m,
+                      u.dtheta_rad);
+      }
     } else {
       const RangeBearing& z = e.measurement();
       std::snprintf(line, sizeof(line), "obs %.9f %d %.12g %.12g %.12g %.12g\n", e.t_s, z.id,
@@ -338,9 +367,12 @@ void WriteRawlog(const std::string& path, const ReplayLog& log) {
       move.timestamp = mrpt::Clock::fromDouble(events[k].t_s);
       move.estimationMethod = mrpt::obs::CActionRobotMovement2D::emOdometry;
       move.rawOdometryIncrementReading = mean;
+      // The step's own covariance, else the thesis robot's motion model (MRPT needs one).
+      const Eigen::Matrix3d q =
+          u.covariance ? *u.covariance : MotionModelCovariance(MotionNoise{}, u);
       mrpt::math::CMatrixDouble33 covariance;
-      covariance.setIdentity();
-      covariance *= 1e-6;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) covariance(r, c) = q(r, c);
       move.poseChange = mrpt::poses::CPosePDFGaussian::Create(mean, covariance);
       actions.insert(move);
       ++k;

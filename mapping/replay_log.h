@@ -10,6 +10,9 @@
 //                                          line is dx = v * dt, dy = 0, dtheta = w * dt (the
 //                                          first odom line is a zero step)
 //   odom <t_s> <dx_m> <dy_m> <dtheta_rad>  increment in the robot frame at the previous pose
+//   odom <t_s> <dx_m> <dy_m> <dtheta_rad> <sigma_dx_m> <sigma_dy_m> <sigma_dtheta_rad>
+//                                          the same with the step's own sigmas, used by the
+//                                          filter instead of its motion model
 //   obs <t_s> <id> <range_m> <bearing_rad> [<sigma_range_m> <sigma_bearing_rad>]
 //                                          from the robot centre; id >= 0 for a known
 //                                          landmark, -1 for one to associate
@@ -18,7 +21,8 @@
 // ReplayLogError naming the file and the line.
 //
 // An MRPT rawlog (either layout: action/sensory-frame pairs or plain observations) gives odometry
-// from CActionRobotMovement2D (the mean of poseChange) and CObservationOdometry (the change
+// from CActionRobotMovement2D (the mean of poseChange, with its covariance, as MRPT's own EKF
+// uses it) and CObservationOdometry (the change
 // between consecutive readings), and measurements from CObservationBearingRange, moved from the
 // sensor (sensorLocationOnRobot) to the robot centre with their covariance. Other observations
 // are skipped; anything else, or a record that does not deserialise, throws ReplayLogError
@@ -56,6 +60,9 @@ struct LogEvent {
 struct ReplayLog {
   std::optional<Eigen::Vector3d> start_pose;  // x_m, y_m, theta_rad from a `start` line
   std::vector<LogEvent> events;               // in time order
+  // The longest range the log's sensor says it measures (an MRPT bearing-range observation's
+  // maxSensorDistance), when it says.
+  std::optional<double> sensor_max_range_m;
 };
 
 struct ReplayLogOptions {

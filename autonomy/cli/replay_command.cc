@@ -219,16 +219,28 @@ int Run(const ReplayArgs& cli) {
                       args.start_sigma_m * args.start_sigma_m,
                       args.start_sigma_rad * args.start_sigma_rad)
           .asDiagonal();
-  mapping::EkfSlam ekf(start, start_covariance, FilterOptions(args.filter));
+  // The sensor's own range when the log gives it and the command line does not.
+  mapping::EkfOptions options = FilterOptions(args.filter);
+  if (!args.filter.max_range_m && log.sensor_max_range_m)
+    options.max_range_m = *log.sensor_max_range_m;
+  mapping::EkfSlam ekf(start, start_covariance, options);
 
   // Predict on odometry, update on measurements; one pose per odometry step.
   std::vector<mapping::TimedPose> trajectory;
+  // Each step's pose after the measurements that follow it (the filter's best estimate of it),
+  // at the step's time.
   int measurements = 0, known = 0, known_rejected = 0;
+  std::optional<double> step_t;
+  const auto close_step = [&] {
+    if (!step_t) return;
+    const Eigen::Vector3d pose = ekf.pose();
+    trajectory.push_back({*step_t, pose.x(), pose.y(), pose.z()});
+  };
   for (const mapping::LogEvent& e : log.events) {
     if (e.is_odometry()) {
+      close_step();
       ekf.Predict(e.odometry());
-      const Eigen::Vector3d pose = ekf.pose();
-      trajectory.push_back({e.t_s, pose.x(), pose.y(), pose.z()});
+      step_t = e.t_s;
     } else {
       ++measurements;
       const mapping::UpdateOutcome o = ekf.Update(e.measurement());
@@ -238,6 +250,7 @@ int Run(const ReplayArgs& cli) {
       }
     }
   }
+  close_step();
   const Eigen::Vector3d pose = ekf.pose();
   const Eigen::Matrix3d pose_covariance = ekf.pose_covariance();
   const mapping::FilterCounters& c = ekf.counters();
