@@ -702,8 +702,12 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
       out->id[i] = static_cast<uint16_t>(p.id);
       Vector3f c = shade_f(albedo, n);
       if (p.glossy) {
-        const Vector3f halfway = (to_light_f - d.normalized()).normalized();
-        c += Vector3f::Constant(0.25f * PowInt(std::max(0.0f, n.dot(halfway)), 40));
+        // Facing away from the half vector (n . h <= 0 before normalising), n . h / |h| is at
+        // most a few 1e-7 and its 40th power is 0 in float: no highlight, as computed in full.
+        const Vector3f h = to_light_f - d.normalized();
+        if (n.dot(h) > 0.0f) {
+          c += Vector3f::Constant(0.25f * PowInt(std::max(0.0f, n.dot(h.normalized())), 40));
+        }
       }
       out->colour[i] = c;
       out->no_depth[i] = black;
@@ -739,7 +743,10 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
         ceiling *= 0.5f + 0.5f * (c2 * c2 * c2).imag() / (r2 * r2 * r2);
       }
       const float patch = std::min(1.0f, fresnel * 0.6f + 0.7f * ceiling);
-      const float spec = 0.9f * PowInt(std::max(0.0f, n.dot((view + to_light_f).normalized())), 60);
+      // As for glossy solids: n . h <= 0 before normalising means a highlight of exactly 0.
+      const Vector3f h = view + to_light_f;
+      const float spec =
+          n.dot(h) > 0.0f ? 0.9f * PowInt(std::max(0.0f, n.dot(h.normalized())), 60) : 0.0f;
       c = (1.0f - patch) * c + patch * Vector3f::Constant(0.85f);
       c += Vector3f::Constant(spec);
       out->colour[i] = c;
