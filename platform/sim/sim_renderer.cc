@@ -825,29 +825,43 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
     truth->objects.clear();
     truth->landmarks.clear();
     truth->ids = cv::Mat(h, w, CV_16UC1, const_cast<uint16_t*>(depth_pass.id.data())).clone();
-    // Pixel counts and boxes per id.
-    std::vector<int> count(kLandmarkIdBase + season_.landmarks.size(), 0);
-    std::vector<cv::Rect> boxes(count.size());
+    // Pixel counts and boxes per id: the extreme columns and rows of each id's pixels (the
+    // same boxes as the union of one-pixel rectangles, without a rectangle union per pixel).
+    struct Extent {
+      int count = 0;
+      int u0 = 0, v0 = 0, u1 = 0, v1 = 0;
+    };
+    std::vector<Extent> extents(kLandmarkIdBase + season_.landmarks.size());
     for (int v = 0; v < h; ++v) {
+      const uint16_t* row = depth_pass.id.data() + static_cast<size_t>(v) * w;
       for (int u = 0; u < w; ++u) {
-        const uint16_t id = depth_pass.id[static_cast<size_t>(v) * w + u];
-        if (id == 0 || id >= count.size()) continue;
-        boxes[id] = count[id]++ ? (boxes[id] | cv::Rect(u, v, 1, 1)) : cv::Rect(u, v, 1, 1);
+        const uint16_t id = row[u];
+        if (id == 0 || id >= extents.size()) continue;
+        Extent& e = extents[id];
+        if (e.count++ == 0) {
+          e.u0 = e.u1 = u, e.v0 = e.v1 = v;
+        } else {
+          e.u0 = std::min(e.u0, u), e.u1 = std::max(e.u1, u), e.v1 = v;  // rows come in order
+        }
       }
     }
+    const auto box_of = [&](int id) {
+      const Extent& e = extents[id];
+      return cv::Rect(e.u0, e.v0, e.u1 - e.u0 + 1, e.v1 - e.v0 + 1);
+    };
     const Eigen::Isometry3d camera_from_world = world_from_camera.inverse();
     for (const SimObject& object : world.objects) {
-      if (object.id >= static_cast<int>(count.size()) || count[object.id] == 0) continue;
+      if (object.id >= static_cast<int>(extents.size()) || extents[object.id].count == 0) continue;
       truth->objects.push_back({object.id, object.type->name, object.colour, object.center_m,
-                                camera_from_world * object.center_m, count[object.id],
-                                boxes[object.id]});
+                                camera_from_world * object.center_m, extents[object.id].count,
+                                box_of(object.id)});
     }
     for (size_t l = 0; l < season_.landmarks.size(); ++l) {
       const int id = kLandmarkIdBase + static_cast<int>(l);
-      if (count[id] == 0) continue;
+      if (extents[id].count == 0) continue;
       const Vector3d& position = landmark_centres_[l];
-      truth->landmarks.push_back(
-          {static_cast<int>(l), position, camera_from_world * position, count[id], boxes[id]});
+      truth->landmarks.push_back({static_cast<int>(l), position, camera_from_world * position,
+                                  extents[id].count, box_of(id)});
     }
   }
   return frame;
