@@ -33,6 +33,7 @@ void CheckInput(const cv::Mat& bgr, const cv::Mat& depth_mm) {
 // Median of the valid depth readings under a mask, raw millimetres; 0 when none.
 double MedianDepthMm(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box) {
   std::vector<uint16_t> readings;
+  readings.reserve(box.area());
   for (int v = box.y; v < box.y + box.height; ++v) {
     const uint8_t* m = mask.ptr<uint8_t>(v);
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
@@ -41,8 +42,7 @@ double MedianDepthMm(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rec
     }
   }
   if (readings.empty()) return 0.0;
-  std::nth_element(readings.begin(), readings.begin() + readings.size() / 2, readings.end());
-  return readings[readings.size() / 2];
+  return MedianReading(readings);
 }
 
 // A circle fitted (algebraic least squares, Kasa) to outline points.
@@ -76,6 +76,7 @@ std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   fit.centre = mean + cv::Point2d(cx, cy);
   fit.radius = std::sqrt(r2);
   std::vector<double> angles;
+  angles.reserve(points.size());
   double sum2 = 0.0;
   for (const cv::Point& p : points) {
     const cv::Point2d d = cv::Point2d(p) - fit.centre;
@@ -343,7 +344,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       min_circularity = std::min(min_circularity, k.min_circularity);
 
     std::vector<std::vector<cv::Point>> blobs;
-    cv::findContours(masks[j].clone(), blobs, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    // OpenCV 4 leaves the image unchanged: no copy of the mask.
+    cv::findContours(masks[j], blobs, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
     for (const std::vector<cv::Point>& blob : blobs) {
       const double blob_area = cv::contourArea(blob);
       if (blob_area < options.min_area_px) {
@@ -359,6 +361,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       cv::Mat blob_mask(window.size(), CV_8UC1, cv::Scalar(0));
       cv::drawContours(blob_mask, std::vector<std::vector<cv::Point>>{blob}, 0, cv::Scalar(255),
                        cv::FILLED, cv::LINE_8, cv::noArray(), 0, -window.tl());
+      bool blob_mask_is_fill = true;  // until a closing changes it
 
       // At its depth, how big should it be? Too small for every kind: noise (not eroded
       // away at a fixed size, which erased far balls in the thesis).
@@ -386,6 +389,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           // K-Means masks have gaps at reflections on the rim: close them at the object's scale.
           if (options.method == DetectMethod::kKMeans && expected_radius_px > 6.0) {
             const int k = std::max(3, static_cast<int>(0.15 * expected_radius_px) | 1);
+            blob_mask_is_fill = false;
             cv::morphologyEx(blob_mask, blob_mask, cv::MORPH_CLOSE,
                              cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
           }
@@ -483,14 +487,18 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           const int pad = options.measurement.erode_px + 2;
           const cv::Rect roi = (d.box + cv::Size(2 * pad, 2 * pad) - cv::Point(pad, pad)) &
                                cv::Rect(0, 0, bgr.cols, bgr.rows);
-          cv::Mat piece_mask(roi.size(), CV_8UC1, cv::Scalar(0));
-          cv::drawContours(piece_mask, std::vector<std::vector<cv::Point>>{piece}, 0,
-                           cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0, -roi.tl());
+          cv::Mat piece_mask;
+          if (convex && blob_mask_is_fill && roi == window) {
+            piece_mask = blob_mask;  // the same contour filled in the same window: no redraw
+          } else {
+            piece_mask = cv::Mat(roi.size(), CV_8UC1, cv::Scalar(0));
+            cv::drawContours(piece_mask, std::vector<std::vector<cv::Point>>{piece}, 0,
+                             cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0, -roi.tl());
+          }
           const cv::Mat depth_roi = depth_mm(roi);
           // The kind whose size fits best.
-          const std::optional<Measurement> surface =
-              MeasureBlob(depth_roi, piece_mask, d.centre_px, 0.0, d.radius_px, *setup.camera,
-                          options.measurement);
+          const std::optional<BlobSurface> surface =
+              MeasureBlobSurface(depth_roi, piece_mask, *setup.camera, options.measurement);
           if (!surface) {
             ++st.without_depth;
           } else {
@@ -508,9 +516,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               continue;
             }
             d.kind = best->name;
-            d.measurement =
-                MeasureBlob(depth_roi, piece_mask, d.centre_px, best->surface_to_centre_m,
-                            d.radius_px, *setup.camera, options.measurement);
+            d.measurement = MeasureFromSurface(*surface, d.centre_px, best->surface_to_centre_m,
+                                               d.radius_px, *setup.camera, options.measurement);
           }
         }
         out.push_back(std::move(d));

@@ -16,6 +16,30 @@ std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& b
                                        const cv::Point2d& centre_px, double surface_to_centre_m,
                                        double radius_px, const CameraModel& camera,
                                        const MeasurementOptions& options) {
+  const std::optional<BlobSurface> surface =
+      MeasureBlobSurface(depth_mm, blob_mask, camera, options);
+  if (!surface) return std::nullopt;
+  return MeasureFromSurface(*surface, centre_px, surface_to_centre_m, radius_px, camera, options);
+}
+
+uint16_t MedianReading(const std::vector<uint16_t>& readings) {
+  size_t rank = readings.size() / 2;
+  uint32_t high[256] = {};
+  for (const uint16_t r : readings) ++high[r >> 8];
+  unsigned h = 0;
+  while (rank >= high[h]) rank -= high[h++];
+  uint32_t low[256] = {};
+  for (const uint16_t r : readings) {
+    if ((r >> 8) == h) ++low[r & 0xff];
+  }
+  unsigned l = 0;
+  while (rank >= low[l]) rank -= low[l++];
+  return static_cast<uint16_t>(h << 8 | l);
+}
+
+std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
+                                              const CameraModel& camera,
+                                              const MeasurementOptions& options) {
   if (depth_mm.empty() || depth_mm.type() != CV_16UC1 || blob_mask.size() != depth_mm.size()) {
     return std::nullopt;
   }
@@ -31,6 +55,7 @@ std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& b
   }
   const cv::Rect box = cv::boundingRect(inner);
   std::vector<uint16_t> readings;
+  readings.reserve(box.area());
   for (int v = box.y; v < box.y + box.height; ++v) {
     const uint8_t* m = inner.ptr<uint8_t>(v);
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
@@ -39,13 +64,18 @@ std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& b
     }
   }
   if (static_cast<int>(readings.size()) < options.min_depth_pixels) return std::nullopt;
-  std::nth_element(readings.begin(), readings.begin() + readings.size() / 2, readings.end());
-  const double surface_m = camera.CorrectDepthM(readings[readings.size() / 2]);
+  const double surface_m = camera.CorrectDepthM(MedianReading(readings));
   if (!(surface_m > 0.0)) return std::nullopt;
+  return BlobSurface{surface_m, static_cast<int>(readings.size())};
+}
 
+Measurement MeasureFromSurface(const BlobSurface& surface, const cv::Point2d& centre_px,
+                               double surface_to_centre_m, double radius_px,
+                               const CameraModel& camera, const MeasurementOptions& options) {
+  const double surface_m = surface.depth_m;
   Measurement m;
   m.depth_m = surface_m;
-  m.depth_pixels = static_cast<int>(readings.size());
+  m.depth_pixels = surface.pixels;
   // The centre lies about one radius behind the visible surface, along the ray.
   const double z = surface_m + surface_to_centre_m;
   m.position_camera_m = camera.BackProject(centre_px.x, centre_px.y, z);

@@ -4,6 +4,7 @@
 // A blob without valid depth yields no measurement; it never yields a NaN.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -40,6 +41,24 @@ std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& b
                                        const cv::Point2d& centre_px, double surface_to_centre_m,
                                        double radius_px, const CameraModel& camera,
                                        const MeasurementOptions& options = {});
+
+// MeasureBlob in two steps, for callers that try several surface_to_centre_m on one blob
+// (the median depth and its erosion are computed once): the blob's corrected surface depth
+// and reading count, nullopt exactly when MeasureBlob gives none; then the measurement.
+struct BlobSurface {
+  double depth_m = 0.0;
+  int pixels = 0;
+};
+std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
+                                              const CameraModel& camera,
+                                              const MeasurementOptions& options = {});
+Measurement MeasureFromSurface(const BlobSurface& surface, const cv::Point2d& centre_px,
+                               double surface_to_centre_m, double radius_px,
+                               const CameraModel& camera, const MeasurementOptions& options = {});
+
+// The median of depth readings as std::nth_element gives it (the element of rank size / 2),
+// by a two-pass radix count instead of partial sorting. `readings` must not be empty.
+uint16_t MedianReading(const std::vector<uint16_t>& readings);
 
 // Range and bearing in the robot frame of a pixel with its (centre) depth.
 Eigen::Vector2d RangeBearing(const CameraModel& camera, double u, double v, double z_m);

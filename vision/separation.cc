@@ -81,7 +81,16 @@ struct BlobFrame {
   double elongation = 1.0;
 };
 
-BlobFrame FrameOf(const Contour& contour) {
+// The centroid alone (from the moments) when the contour has area; nullopt otherwise, when
+// FrameOf falls back to the min-area rectangle's centre.
+std::optional<cv::Point2d> MomentCentroid(const Contour& contour) {
+  const cv::Moments m = cv::moments(contour);
+  if (!(m.m00 > 0.0)) return std::nullopt;
+  return cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
+}
+
+// `centroid`: MomentCentroid(contour), when the caller has it already.
+BlobFrame FrameOf(const Contour& contour, const std::optional<cv::Point2d>& centroid) {
   BlobFrame frame;
   const cv::RotatedRect rect = cv::minAreaRect(contour);
   cv::Point2f corners[4];
@@ -91,9 +100,7 @@ BlobFrame FrameOf(const Contour& contour) {
   frame.long_axis = Unit(len_a >= len_b ? side_a : side_b);
   frame.width_px = std::min(len_a, len_b);
   frame.elongation = frame.width_px > 0.0 ? std::max(len_a, len_b) / frame.width_px : 1.0;
-  const cv::Moments m = cv::moments(contour);
-  frame.centroid = m.m00 > 0.0 ? cv::Point2d(m.m10 / m.m00, m.m01 / m.m00)
-                               : cv::Point2d(rect.center.x, rect.center.y);
+  frame.centroid = centroid ? *centroid : cv::Point2d(rect.center.x, rect.center.y);
   return frame;
 }
 
@@ -335,11 +342,17 @@ std::optional<Cut> ChooseCut(const cv::Mat& binary, const Contour& contour,
   const double equivalent_radius_px = std::sqrt(area / kPi);
   Contour polygon;
   cv::approxPolyDP(contour, polygon, kApproxEpsilonPx, /*closed=*/true);
-  const BlobFrame frame = FrameOf(contour);
-  const std::vector<Defect> defects = FindDefects(
-      polygon, frame.centroid,
-      std::max(kMinDefectDepthPx, options.min_defect_depth_ratio * equivalent_radius_px));
+  // Defects first (they need only the centroid): most blobs have none, and then the
+  // min-area rectangle (a convex hull of every outline pixel) is not needed.
+  const std::optional<cv::Point2d> centroid = MomentCentroid(contour);
+  const double min_depth_px =
+      std::max(kMinDefectDepthPx, options.min_defect_depth_ratio * equivalent_radius_px);
+  std::optional<BlobFrame> early_frame;
+  if (!centroid) early_frame = FrameOf(contour, centroid);
+  const std::vector<Defect> defects =
+      FindDefects(polygon, centroid ? *centroid : early_frame->centroid, min_depth_px);
   if (defects.empty()) return std::nullopt;
+  const BlobFrame frame = early_frame ? *early_frame : FrameOf(contour, centroid);
   const int n = static_cast<int>(defects.size());
 
   // A compact cluster (three or more defects, no long side) is cut along two necks that meet
@@ -409,27 +422,42 @@ SeparationResult SeparateByDefects(const cv::Mat& binary, const SeparationOption
   // Holes are gaps enclosed by a ring of touching balls (or reflections inside one): fill
   // them so that cuts may cross them.
   cv::Mat work = cv::Mat::zeros(binary.size(), CV_8U);
-  cv::drawContours(work, ExternalContours(binary), -1, cv::Scalar(255), cv::FILLED);
-  // Each piece is measured against the (filled) blob it came from.
+  const std::vector<Contour> blobs = ExternalContours(binary);
+  cv::drawContours(work, blobs, -1, cv::Scalar(255), cv::FILLED);
+  // Each piece is measured against the (filled) blob it came from. One blob (a detector's
+  // window) fills one 8-connected region: its area is the pixel count, no labelling needed.
   cv::Mat labels, stats, centroids;
-  cv::connectedComponentsWithStats(work, labels, stats, centroids, 8, CV_32S);
+  double single_blob_area = 0.0;
+  if (blobs.size() == 1) {
+    single_blob_area = static_cast<double>(cv::countNonZero(work));
+  } else {
+    cv::connectedComponentsWithStats(work, labels, stats, centroids, 8, CV_32S);
+  }
   auto blob_area = [&](const Contour& piece) {
+    if (blobs.size() == 1) return single_blob_area;
     return static_cast<double>(stats.at<int>(labels.at<int>(piece.front()), cv::CC_STAT_AREA));
   };
+  // The outlines of `work` as it is now: after a pass that cuts nothing they are the final ones.
+  std::vector<Contour> contours;
+  bool contours_current = false;
   for (int pass = 0; pass < options.max_passes; ++pass) {
     // Find every blob's cut first, then draw them: one cut per blob per pass.
     std::vector<Cut> cuts;
-    for (const Contour& contour : ExternalContours(work)) {
+    contours = ExternalContours(work);
+    contours_current = true;
+    for (const Contour& contour : contours) {
       const double min_piece_area_px = options.min_piece_area_ratio * blob_area(contour);
       if (cv::contourArea(contour) < 2.0 * min_piece_area_px) continue;
       if (auto cut = ChooseCut(work, contour, options, min_piece_area_px)) cuts.push_back(*cut);
     }
     if (cuts.empty()) break;  // the thesis's flag: nothing left to separate
     for (const Cut& cut : cuts) DrawCut(cut, &work);
+    contours_current = false;
     ++result.passes;
     result.cuts += static_cast<int>(cuts.size());
   }
-  for (Contour& contour : ExternalContours(work)) {
+  if (!contours_current) contours = ExternalContours(work);
+  for (Contour& contour : contours) {
     if (cv::contourArea(contour) >= options.min_piece_area_ratio * blob_area(contour)) {
       result.pieces.push_back(std::move(contour));
     }
