@@ -1,0 +1,173 @@
+// The EKF on logs it was not tuned to: odometry noisier than its motion model, a kidnapped
+// robot, and a log that matches the model (its NIS must then sit near its expectation).
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "mapping/ekf_slam.h"
+#include "mapping/metrics.h"
+
+namespace slamo::mapping {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct LoggedRun {
+  std::vector<std::pair<OdometryStep, std::vector<RangeBearing>>> steps;  // odometry, then seen
+  std::vector<Eigen::Vector3d> truth;                                     // after each step
+  std::vector<Eigen::Vector2d> landmarks;
+};
+
+// Two laps of a 4 m square in 0.1 m steps, 90 degree turns in nine steps, among 16 landmarks
+// with known ids seen within 4 m. The odometry's error is the filter's default motion model
+// times `noise_factor` (drawn from a fixed seed); a kidnap at step `kidnap_step` moves the
+// robot `kidnap_m` sideways without the odometry knowing.
+LoggedRun MakeRun(double noise_factor, int seed, int kidnap_step = -1, double kidnap_m = 0.0) {
+  LoggedRun run;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) run.landmarks.emplace_back(-1.0 + 2.0 * i, -1.0 + 2.0 * j);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const MotionNoise model;
+  const double sigma_range = 0.02, sigma_bearing = 0.01;
+  Eigen::Vector3d pose(0.0, 0.0, 0.0);
+  int index = 0;
+  const auto step = [&](double dx, double dtheta) {
+    const OdometryStep commanded{dx, 0.0, dtheta};
+    const Eigen::Vector3d sigma =
+        MotionModelCovariance(model, commanded).diagonal().cwiseSqrt() * noise_factor;
+    // The robot moves by the odometry reading's error; the odometry reads the command.
+    OdometryStep actual{dx + sigma.x() * n01(rng), sigma.y() * n01(rng),
+                        dtheta + sigma.z() * n01(rng)};
+    if (index++ == kidnap_step) actual.dy_m += kidnap_m;
+    pose = EkfSlam::Move(pose, actual, nullptr, nullptr);
+    std::vector<RangeBearing> seen;
+    for (size_t l = 0; l < run.landmarks.size(); ++l) {
+      const Eigen::Vector2d h = EkfSlam::Observe(pose, run.landmarks[l]);
+      if (h.x() > 4.0) continue;
+      RangeBearing z;
+      z.range_m = h.x() + sigma_range * n01(rng);
+      z.bearing_rad = std::remainder(h.y() + sigma_bearing * n01(rng), 2.0 * kPi);
+      z.covariance =
+          Eigen::Vector2d(sigma_range * sigma_range, sigma_bearing * sigma_bearing).asDiagonal();
+      z.id = static_cast<int>(l);
+      seen.push_back(z);
+    }
+    run.steps.push_back({commanded, seen});
+    run.truth.push_back(pose);
+  };
+  for (int lap = 0; lap < 2; ++lap) {
+    for (int side = 0; side < 4; ++side) {
+      for (int i = 0; i < 40; ++i) step(0.1, 0.0);
+      for (int i = 0; i < 9; ++i) step(0.0, kPi / 18.0);
+    }
+  }
+  return run;
+}
+
+struct Outcome {
+  double ate_m = 0.0;            // every step's pose after its measurements, aligned
+  double landmark_rmse_m = 0.0;  // in the trajectory's alignment
+  double rejected_fraction = 0.0;
+  std::vector<double> error_m;  // unaligned position error after each step
+  FilterCounters counters;
+  double final_scale = 1.0;
+};
+
+Outcome Replay(const LoggedRun& run, bool adaptive) {
+  EkfOptions options;
+  options.adaptive.enabled = adaptive;
+  options.max_range_m = 4.5;
+  EkfSlam ekf(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-6, options);
+  Outcome out;
+  std::vector<Eigen::Vector2d> truth, estimate;
+  int tried = 0;
+  for (size_t k = 0; k < run.steps.size(); ++k) {
+    ekf.Predict(run.steps[k].first);
+    for (const RangeBearing& z : run.steps[k].second) {
+      ++tried;
+      ekf.Update(z);
+    }
+    truth.push_back(run.truth[k].head<2>());
+    estimate.push_back(ekf.pose().head<2>());
+    out.error_m.push_back((truth.back() - estimate.back()).norm());
+  }
+  const AteResult ate = PairedTrajectoryError(truth, estimate, /*align=*/true);
+  out.ate_m = ate.rmse_m;
+  std::vector<LandmarkPoint> true_landmarks, mapped;
+  for (size_t l = 0; l < run.landmarks.size(); ++l)
+    true_landmarks.push_back({static_cast<int>(l), run.landmarks[l].x(), run.landmarks[l].y()});
+  for (int i = 0; i < ekf.landmark_count(); ++i)
+    mapped.push_back({ekf.landmark_id(i), ekf.landmark(i).x(), ekf.landmark(i).y()});
+  out.landmark_rmse_m = LandmarkRmse(true_landmarks, mapped, ate.alignment).rmse_m;
+  out.counters = ekf.counters();
+  out.rejected_fraction = static_cast<double>(out.counters.rejected) / tried;
+  out.final_scale = ekf.process_noise_scale();
+  return out;
+}
+
+TEST(AdaptiveEkfTest, NisStaysNearItsExpectationWhenTheLogMatchesTheModel) {
+  for (int seed : {1, 2, 3}) {
+    const Outcome o = Replay(MakeRun(1.0, seed), /*adaptive=*/true);
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    // Expected 2 (2 dof); the average over some 2000 updates is within a few per cent of it
+    // when the model is right.
+    EXPECT_GT(o.counters.MeanNis(), 1.6);
+    EXPECT_LT(o.counters.MeanNis(), 2.5);
+    EXPECT_LT(o.rejected_fraction, 0.02);
+    EXPECT_EQ(o.counters.reacquired, 0);
+    EXPECT_LT(o.ate_m, 0.05);
+  }
+}
+
+TEST(AdaptiveEkfTest, FiveTimesTheAssumedMotionNoiseStillMaps) {
+  for (int seed : {1, 2, 3}) {
+    const LoggedRun run = MakeRun(5.0, seed);
+    const Outcome fixed = Replay(run, /*adaptive=*/false);
+    const Outcome adaptive = Replay(run, /*adaptive=*/true);
+    SCOPED_TRACE("seed " + std::to_string(seed) + ": fixed ATE " + std::to_string(fixed.ate_m) +
+                 " landmarks " + std::to_string(fixed.landmark_rmse_m) + " rejected " +
+                 std::to_string(fixed.rejected_fraction) + "; adaptive ATE " +
+                 std::to_string(adaptive.ate_m) + " landmarks " +
+                 std::to_string(adaptive.landmark_rmse_m) + " rejected " +
+                 std::to_string(adaptive.rejected_fraction));
+    EXPECT_LT(adaptive.ate_m, 0.05);
+    EXPECT_LT(adaptive.landmark_rmse_m, 0.05);
+    EXPECT_LT(adaptive.rejected_fraction, 0.10);
+    EXPECT_GE(adaptive.counters.adaptive_episodes, 1);  // it noticed
+    EXPECT_GT(adaptive.final_scale, 1.0);
+    EXPECT_LE(adaptive.ate_m, fixed.ate_m);
+  }
+}
+
+TEST(AdaptiveEkfTest, AKidnappedRobotIsReacquiredWithinAFewSteps) {
+  // Half a metre sideways at step 100, on a log that otherwise matches the model.
+  const int kidnap = 100;
+  const LoggedRun run = MakeRun(1.0, 4, kidnap, 0.5);
+  const Outcome fixed = Replay(run, /*adaptive=*/false);
+  const Outcome adaptive = Replay(run, /*adaptive=*/true);
+  EXPECT_GE(adaptive.counters.reacquired, 1);
+  // Within 10 cm of the truth from two steps (a handful of measurements) after the kidnap on,
+  // as before it (unaligned, the map's frame drifts by a few centimetres).
+  for (size_t k = kidnap + 2; k < adaptive.error_m.size(); ++k)
+    ASSERT_LT(adaptive.error_m[k], 0.1) << "step " << k;
+  // The filter as it was stays lost.
+  EXPECT_EQ(fixed.counters.reacquired, 0);
+  EXPECT_GT(fixed.error_m[kidnap + 10], 0.3);
+}
+
+TEST(AdaptiveEkfTest, AStepsOwnCovarianceReplacesTheMotionModel) {
+  EkfSlam model(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());
+  EkfSlam own(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());
+  const Eigen::Matrix3d q = Eigen::Vector3d(0.04, 0.01, 0.0025).asDiagonal();
+  model.Predict(OdometryStep{0.5, 0.0, 0.0});
+  own.Predict(OdometryStep{0.5, 0.0, 0.0, q});
+  EXPECT_TRUE(own.pose_covariance().isApprox(q));
+  EXPECT_TRUE(model.pose_covariance().isApprox(
+      MotionModelCovariance(MotionNoise{}, OdometryStep{0.5, 0.0, 0.0})));
+}
+
+}  // namespace
+}  // namespace slamo::mapping
