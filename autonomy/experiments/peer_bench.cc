@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <random>
 #include <stdexcept>
 
@@ -151,6 +152,7 @@ PeerTrack RunSlamoFilter(const PeerScenario& scenario, const PeerBenchOptions& o
   mapping::EkfOptions ekf;
   ekf.motion = PeerMotionNoise(options);
   ekf.max_range_m = options.max_range_m;
+  ekf.adaptive.enabled = options.adaptive;
   // Known start, as MRPT's filter (it starts at (0, 0, 0) with zero covariance).
   mapping::EkfSlam filter(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero(), ekf);
   PeerTrack track;
@@ -165,6 +167,9 @@ PeerTrack RunSlamoFilter(const PeerScenario& scenario, const PeerBenchOptions& o
     track.poses.push_back(Timed(static_cast<int>(k), options, filter.pose()));
     track.covariances.push_back(filter.pose_covariance());
   }
+  for (int i = 0; i < filter.landmark_count(); ++i)
+    track.landmarks.push_back(
+        {filter.landmark_id(i), filter.landmark(i).x(), filter.landmark(i).y()});
   return track;
 }
 
@@ -233,6 +238,18 @@ PeerTrack RunMrptFilter(const PeerScenario& scenario, const PeerBenchOptions& op
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) cov(r, c) = pose.cov(r, c);
     track.covariances.push_back(cov);
+  }
+  // The map, with the landmarks' ids.
+  mrpt::poses::CPosePDFGaussian pose;
+  std::vector<mrpt::math::TPoint2D> positions;
+  std::map<unsigned int, mrpt::maps::CLandmark::TLandmarkID> ids;
+  mrpt::math::CVectorDouble state;
+  mrpt::math::CMatrixDouble covariance;
+  filter.getCurrentState(pose, positions, ids, state, covariance);
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const auto id = ids.find(static_cast<unsigned int>(i));
+    track.landmarks.push_back(
+        {id == ids.end() ? -1 : static_cast<int>(id->second), positions[i].x, positions[i].y});
   }
   return track;
 }

@@ -28,6 +28,7 @@ struct PeerBenchOptions {
   double sigma_bearing_rad = 0.017453292519943295;  // bearing noise (1 deg)
   double sigma_step_xy_m = 0.005;                   // odometry noise per step, forward and sideways
   double sigma_step_heading_rad = 0.01;             // odometry heading noise per step
+  bool adaptive = false;  // slamo's filter checks itself (mapping::AdaptiveOptions)
 };
 
 // The motion noise slamo's filter is given: a fixed covariance per step, the one the
@@ -59,6 +60,7 @@ struct PeerTrack {
   std::vector<Eigen::Matrix3d> covariances;
   double filter_s = 0.0;  // wall clock inside the filter's step calls only
   int rejected = 0;       // measurements the filter refused (slamo's outcome kRejected)
+  std::vector<mapping::LandmarkPoint> landmarks;  // the map at the end, with the landmarks' ids
 };
 
 // slamo's EkfSlam: Predict, then Update with each measurement, per step.
