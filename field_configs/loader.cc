@@ -228,15 +228,34 @@ class SeasonParser {
     return *type;
   }
 
+  std::string TypeColour(const YamlReader& node, const ObjectType& type) const {
+    const std::string colour = ColourName(node);
+    if (std::find(type.colours.begin(), type.colours.end(), colour) == type.colours.end()) {
+      node.Fail("one of the colours of object type '" + type.name + "'");
+    }
+    return colour;
+  }
+
   void ParseObject(const YamlReader& node) {
-    node.AllowKeys({"type", "colour", "position_m", "region", "count", "z_m"});
+    node.AllowKeys({"type", "colour", "stack", "position_m", "region", "count", "z_m"});
     ObjectPlacement p;
     const ObjectType& type = ObjectTypeNamed(node.Required("type"));
     p.type = type.name;
-    const YamlReader colour = node.Required("colour");
-    p.colour = ColourName(colour);
-    if (std::find(type.colours.begin(), type.colours.end(), p.colour) == type.colours.end()) {
-      colour.Fail("one of the colours of object type '" + type.name + "'");
+    // A stack: objects of one type resting on each other, colours listed top first.
+    std::vector<std::string> stack_colours;
+    if (node.Has("colour") == node.Has("stack"))
+      node.FailRule("give exactly one of 'colour' or 'stack' (a list of colours, top first)");
+    if (node.Has("stack")) {
+      const YamlReader stack = node.Required("stack");
+      for (const YamlReader& c : stack.Items())
+        stack_colours.insert(stack_colours.begin(), TypeColour(c, type));
+      if (stack_colours.size() < 2 || stack_colours.size() > 20)
+        stack.Fail("a stack of 2 to 20 colours, top first (one object: use 'colour')");
+      if (!node.Has("position_m"))
+        stack.FailRule("'stack' goes with 'position_m' (a stack stands at one place)");
+      p.colour = stack_colours.front();
+    } else {
+      p.colour = TypeColour(node.Required("colour"), type);
     }
     const double radius = type.size_m / 2.0;
     const bool has_position = node.Has("position_m");
@@ -248,14 +267,19 @@ class SeasonParser {
       if (node.Has("count"))
         node.Required("count").FailRule(
             "'count' goes with 'region'; a fixed position places one object");
+      // Objects overlap when their footprints overlap and their heights [z, z + height] do
+      // (a stack's objects rest on each other, so they touch without overlapping).
+      const double z = node.Has("z_m") ? node.Required("z_m").Number() : 0.0;
+      const double top =
+          z + type.height_m * static_cast<double>(std::max<size_t>(1, stack_colours.size()));
       for (const ObjectPlacement& other : config_->objects) {
         if (!other.position_m) continue;
-        const double other_radius = config_->FindObjectType(other.type)->size_m / 2.0;
+        const ObjectType& other_type = *config_->FindObjectType(other.type);
+        const double other_radius = other_type.size_m / 2.0;
         const double d = std::hypot(other.position_m->x - p.position_m->x,
                                     other.position_m->y - p.position_m->y);
-        const double z_gap =
-            std::abs(other.z_m - (node.Has("z_m") ? node.Required("z_m").Number() : 0.0));
-        if (d < radius + other_radius - 1e-3 && z_gap < radius + other_radius) {
+        const bool z_overlap = z < other.z_m + other_type.height_m - 1e-3 && other.z_m < top - 1e-3;
+        if (d < radius + other_radius - 1e-3 && z_overlap) {
           position.Fail("a position not overlapping another object (one at [" +
                         FormatMetres(other.position_m->x) + ", " +
                         FormatMetres(other.position_m->y) + "])");
@@ -272,22 +296,65 @@ class SeasonParser {
       p.count = node.Required("count").IntInRange(1, 500);
     }
     if (auto z = node.Optional("z_m")) p.z_m = z->InRange(0.0, 3.0);
-    config_->objects.push_back(p);
+    if (stack_colours.empty()) {
+      config_->objects.push_back(p);
+      return;
+    }
+    // One placement per object of the stack, bottom first, each on the one below.
+    const double bottom = p.z_m;
+    p.stack_size = static_cast<int>(stack_colours.size());
+    for (size_t k = 0; k < stack_colours.size(); ++k) {
+      p.colour = stack_colours[k];
+      p.stack_level = static_cast<int>(k);
+      p.z_m = bottom + type.height_m * static_cast<double>(k);
+      config_->objects.push_back(p);
+    }
+  }
+
+  // A triangle zone: three corners inside the field, not all on one line; its centroid and
+  // bounding box fill center_m and size_m.
+  void ParseTriangle(const YamlReader& node, Goal* g) const {
+    for (const char* key : {"center_m", "size_m", "radius_m", "yaw_deg"}) {
+      if (node.Has(key))
+        node.Required(key).FailRule(std::string(key) +
+                                    " is not for a triangle; its three vertices_m define it");
+    }
+    const YamlReader vertices = node.Required("vertices_m");
+    for (const YamlReader& v : vertices.Items()) g->vertices_m.push_back(FieldPoint(v));
+    if (g->vertices_m.size() != 3) vertices.Fail("three vertices [[x, y], [x, y], [x, y]]");
+    const Vec2 &a = g->vertices_m[0], &b = g->vertices_m[1], &c = g->vertices_m[2];
+    const double area2 = std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
+    if (area2 < 1e-4) vertices.Fail("three vertices that enclose an area (not on one line)");
+    g->center_m = {(a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0};
+    const double min_x = std::min({a.x, b.x, c.x}), max_x = std::max({a.x, b.x, c.x});
+    const double min_y = std::min({a.y, b.y, c.y}), max_y = std::max({a.y, b.y, c.y});
+    g->size_m = {max_x - min_x, max_y - min_y};
   }
 
   void ParseGoal(const YamlReader& node) {
     node.AllowKeys({"name", "kind", "alliance", "shape", "center_m", "size_m", "radius_m",
-                    "height_m", "yaw_deg", "points"});
+                    "vertices_m", "height_m", "yaw_deg", "points"});
     Goal g;
     g.name = node.Required("name").String();
     g.kind = node.Required("kind").OneOf({"zone", "goal"}) == 0 ? GoalKind::kZone : GoalKind::kGoal;
     g.alliance = ParseAlliance(node.Required("alliance"), true);
-    g.shape = node.Required("shape").OneOf({"box", "cylinder"}) == 0 ? SolidShape::kBox
-                                                                     : SolidShape::kCylinder;
-    g.center_m = FieldPoint(node.Required("center_m"));
+    const YamlReader shape = node.Required("shape");
+    const int shape_index = shape.OneOf({"box", "cylinder", "triangle"});
+    g.shape = shape_index == 0   ? SolidShape::kBox
+              : shape_index == 1 ? SolidShape::kCylinder
+                                 : SolidShape::kTriangle;
+    if (g.shape == SolidShape::kTriangle) {
+      if (g.kind != GoalKind::kZone)
+        shape.FailRule("a triangle is a floor zone (kind: zone); a goal is a box or a cylinder");
+      ParseTriangle(node, &g);
+    } else {
+      if (node.Has("vertices_m"))
+        node.Required("vertices_m").FailRule("vertices_m is for triangles (shape: triangle)");
+      g.center_m = FieldPoint(node.Required("center_m"));
+    }
     if (g.shape == SolidShape::kBox) {
       g.size_m = PositiveSize(node.Required("size_m"));
-    } else {
+    } else if (g.shape == SolidShape::kCylinder) {
       g.radius_m = node.Required("radius_m").Positive();
     }
     if (g.kind == GoalKind::kGoal) {
@@ -345,7 +412,7 @@ class SeasonParser {
 namespace {
 
 void ParseRobot(const YamlReader& root, RobotConfig* robot) {
-  root.AllowKeys({"name", "footprint", "mass_kg", "drive", "intake", "camera"});
+  root.AllowKeys({"name", "footprint", "mass_kg", "drive", "intake", "camera", "imu"});
   robot->name = root.Required("name").String();
   const YamlReader footprint = root.Required("footprint");
   footprint.AllowKeys({"length_m", "width_m", "height_m"});
@@ -357,7 +424,7 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   const YamlReader drive = root.Required("drive");
   drive.AllowKeys({"wheel_diameter_m", "track_width_m", "max_speed_mps", "cruise_speed_mps",
                    "match_speed_mps", "turn_rate_dps", "accel_mps2", "encoder_ticks_per_rev", "pwm",
-                   "pid"});
+                   "pid", "motor", "slip"});
   DriveConfig& d = robot->drive;
   d.wheel_diameter_m = drive.Required("wheel_diameter_m").InRange(0.01, 0.5);
   const YamlReader track = drive.Required("track_width_m");
@@ -378,10 +445,11 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
 
   const YamlReader pwm = drive.Required("pwm");
   pwm.AllowKeys({"full_forward", "stop", "full_reverse", "deadband", "curve_exponent"});
-  d.pwm.full_forward = pwm.Required("full_forward").IntInRange(0, 255);
-  d.pwm.stop = pwm.Required("stop").IntInRange(0, 255);
+  // Servo PWM (0 / 90 / 180) or a signed command (V5: 127 / 0 / -127).
+  d.pwm.full_forward = pwm.Required("full_forward").IntInRange(-255, 255);
+  d.pwm.stop = pwm.Required("stop").IntInRange(-255, 255);
   const YamlReader reverse = pwm.Required("full_reverse");
-  d.pwm.full_reverse = reverse.IntInRange(0, 255);
+  d.pwm.full_reverse = reverse.IntInRange(-255, 255);
   const bool stop_between = (d.pwm.full_forward < d.pwm.stop && d.pwm.stop < d.pwm.full_reverse) ||
                             (d.pwm.full_forward > d.pwm.stop && d.pwm.stop > d.pwm.full_reverse);
   if (!stop_between)
@@ -398,6 +466,41 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   d.pid.kd = pid.Required("kd").NonNegative();
   d.pid.rate_hz = pid.Required("rate_hz").InRange(1.0, 10000.0);
   d.pid.integral_limit = pid.Required("integral_limit").NonNegative();
+
+  if (auto motor = drive.Optional("motor")) {
+    motor->AllowKeys({"type", "cartridge_rpm", "gear_ratio", "count"});
+    MotorConfig m;
+    m.type = motor->Required("type").String();
+    m.cartridge_rpm = motor->Required("cartridge_rpm").InRange(1.0, 20000.0);
+    m.gear_ratio = motor->Required("gear_ratio").InRange(0.01, 100.0);
+    m.count = motor->Required("count").IntInRange(1, 16);
+    if (m.type == "v5_smart_motor" && m.cartridge_rpm != 100.0 && m.cartridge_rpm != 200.0 &&
+        m.cartridge_rpm != 600.0) {
+      motor->Required("cartridge_rpm")
+          .Fail("a V5 cartridge's free speed: 100 (red), 200 (green) or 600 (blue) rpm");
+    }
+    const double free_mps = m.FreeSpeedMps(d.wheel_diameter_m);
+    if (d.max_speed_mps > free_mps * 1.01) {
+      drive.Required("max_speed_mps")
+          .Fail("a top speed no faster than the motors' free speed (" + FormatMetres(free_mps) +
+                " m/s from cartridge_rpm x gear_ratio x pi x wheel_diameter_m / 60)");
+    }
+    d.motor = m;
+  }
+  if (auto slip = drive.Optional("slip")) {
+    slip->AllowKeys({"straight_mean", "straight_stddev", "side_stddev", "turn_mean", "turn_stddev",
+                     "pivot_offset_m", "pivot_stddev_m", "motor_time_constant_s"});
+    SlipConfig sc;
+    sc.straight_mean = slip->Required("straight_mean").InRange(-0.5, 0.95);
+    sc.straight_stddev = slip->Required("straight_stddev").InRange(0.0, 0.5);
+    sc.side_stddev = slip->Required("side_stddev").InRange(0.0, 0.5);
+    sc.turn_mean = slip->Required("turn_mean").InRange(-0.5, 0.95);
+    sc.turn_stddev = slip->Required("turn_stddev").InRange(0.0, 0.5);
+    sc.pivot_offset_m = slip->Required("pivot_offset_m").InRange(-0.5, 0.5);
+    sc.pivot_stddev_m = slip->Required("pivot_stddev_m").InRange(0.0, 0.2);
+    sc.motor_time_constant_s = slip->Required("motor_time_constant_s").InRange(0.001, 2.0);
+    d.slip = sc;
+  }
 
   const YamlReader intake = root.Required("intake");
   intake.AllowKeys({"reach_m", "capacity"});
@@ -454,6 +557,15 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   correction.AllowKeys({"a", "b_mm"});
   c.depth_correction.a = correction.Required("a").InRange(0.5, 2.0);
   c.depth_correction.b_mm = correction.Required("b_mm").InRange(-500.0, 500.0);
+
+  if (auto imu = root.Optional("imu")) {
+    imu->AllowKeys({"model", "noise_deg", "drift_deg_per_sqrt_s"});
+    ImuConfig i;
+    i.model = imu->Required("model").String();
+    i.noise_deg = imu->Required("noise_deg").InRange(0.0, 10.0);
+    i.drift_deg_per_sqrt_s = imu->Required("drift_deg_per_sqrt_s").InRange(0.0, 10.0);
+    robot->imu = i;
+  }
 }
 
 std::vector<std::string> ListYamlStems(const fs::path& dir) {

@@ -3,6 +3,7 @@
 // from field_configs/robots/<robot>.yaml by LoadRobotConfig(); plain data afterwards.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,33 @@ struct PidGains {
   double integral_limit = 0.0;  // anti-windup clamp on the integral term (PWM units)
 };
 
+// The motors behind the drive, for the record and for checking max_speed_mps against the free
+// speed they allow (optional in the file; the thesis robot's 393 motors are described in a
+// comment only).
+struct MotorConfig {
+  std::string type;          // e.g. v5_smart_motor
+  double cartridge_rpm = 0;  // V5: 100 (red), 200 (green) or 600 (blue) free speed
+  double gear_ratio = 1.0;   // wheel rpm / motor rpm (36:48 -> 0.75)
+  int count = 0;             // motors on the drive
+  // No-load wheel surface speed (m/s).
+  double FreeSpeedMps(double wheel_diameter_m) const {
+    return cartridge_rpm * gear_ratio * 3.14159265358979 * wheel_diameter_m / 60.0;
+  }
+};
+
+// The simulator's slip model for this drive (optional in the file; the defaults are the
+// thesis robot's calibration, platform/sim/sim_drive.h). Fractions as in SimDriveOptions.
+struct SlipConfig {
+  double straight_mean = 0.165;
+  double straight_stddev = 0.06;
+  double side_stddev = 0.04;
+  double turn_mean = 0.01;
+  double turn_stddev = 0.03;
+  double pivot_offset_m = 0.07;
+  double pivot_stddev_m = 0.01;
+  double motor_time_constant_s = 0.08;
+};
+
 struct DriveConfig {
   double wheel_diameter_m = 0.06985;   // 2.75 in
   double track_width_m = 0.0;          // distance between left and right wheel contact lines
@@ -36,6 +64,16 @@ struct DriveConfig {
   double encoder_ticks_per_rev = 0.0;  // at the wheel
   PwmConvention pwm;
   PidGains pid;
+  std::optional<MotorConfig> motor;
+  std::optional<SlipConfig> slip;
+};
+
+// A yaw gyro / inertial sensor on the robot (optional in the file: without it the simulator's
+// default gyro is used, SimGyroOptions).
+struct ImuConfig {
+  std::string model;                  // e.g. v5_inertial_sensor
+  double noise_deg = 0.2;             // white noise of one heading reading
+  double drift_deg_per_sqrt_s = 0.1;  // bias random walk
 };
 
 // Depth noise: standard deviation of one depth reading by distance, interpolated linearly.
@@ -90,6 +128,7 @@ struct RobotConfig {
   DriveConfig drive;
   IntakeConfig intake;
   CameraConfig camera;
+  std::optional<ImuConfig> imu;
 };
 
 }  // namespace slamo::field

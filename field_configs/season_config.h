@@ -27,8 +27,9 @@ struct Rgb {
 
 enum class Alliance { kNone, kRed, kBlue };
 
-// Fixed field elements as simple solids (goals, posts, barriers, troughs, ladders...).
-enum class SolidShape { kBox, kCylinder };
+// Fixed field elements as simple solids (goals, posts, barriers, troughs, ladders...). A
+// triangle is a floor zone only (a corner cut off by a bar or a tape diagonal).
+enum class SolidShape { kBox, kCylinder, kTriangle };
 
 struct Structure {
   std::string name;
@@ -41,6 +42,10 @@ struct Structure {
   double yaw_deg = 0.0;
   std::string colour;        // a name from SeasonConfig::colours
   bool blocks_robot = true;  // false: the robot drives over or under it (a bump, a tape line)
+
+  // Robots pass under it (blocks_robot false and raised off the floor): a barrier or bar they
+  // drive beneath. Objects taller than z_min_m still cannot pass (see PointBlocksObject).
+  bool PassUnder() const { return !blocks_robot && z_min_m > 0.0; }
 };
 
 enum class LandmarkShape { kDisc, kSquare, kCylinder, kSphere };
@@ -82,6 +87,10 @@ struct ObjectPlacement {
   std::optional<Region> region;
   int count = 1;
   double z_m = 0.0;  // height of the object's bottom (0: on the floor)
+  // Position in a stack (`stack:` in the file): 0 for the bottom object (or one not stacked),
+  // k for the k-th object resting on the one below it; stack_size objects in the stack.
+  int stack_level = 0;
+  int stack_size = 1;
 };
 
 enum class GoalKind { kZone, kGoal };  // zone: floor area; goal: a structure objects go into
@@ -91,10 +100,11 @@ struct Goal {
   GoalKind kind = GoalKind::kZone;
   Alliance alliance = Alliance::kNone;  // kNone: scores for the object's colour / either side
   SolidShape shape = SolidShape::kBox;
-  Vec2 center_m;
-  Vec2 size_m;
+  Vec2 center_m;  // a triangle's centroid
+  Vec2 size_m;    // a triangle's bounding box (axis-aligned)
   double radius_m = 0.0;
-  double height_m = 0.0;  // opening height for a goal; 0 for a floor zone
+  std::vector<Vec2> vertices_m;  // triangle zones only: the three corners
+  double height_m = 0.0;         // opening height for a goal; 0 for a floor zone
   double yaw_deg = 0.0;
   std::map<std::string, int> points;  // object type -> points for one object scored here
 };

@@ -44,9 +44,27 @@ bool PointInBlockingStructure(const SeasonConfig& season, const Eigen::Vector2d&
   return false;
 }
 
+bool PointBlocksObject(const SeasonConfig& season, const Eigen::Vector2d& p, double radius_m,
+                       double object_height_m) {
+  for (const Structure& s : season.structures) {
+    const bool blocks = s.blocks_robot || (s.PassUnder() && object_height_m > s.z_min_m);
+    if (blocks && DistanceToStructure(s, p) <= radius_m) return true;
+  }
+  return false;
+}
+
 bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p) {
   const Eigen::Vector2d d = p - Eigen::Vector2d(goal.center_m.x, goal.center_m.y);
   if (goal.shape == SolidShape::kCylinder) return d.norm() <= goal.radius_m;
+  if (goal.shape == SolidShape::kTriangle) {
+    // Inside (or on the edge) when p is on the same side of all three edges.
+    const auto cross = [&](const field::Vec2& a, const field::Vec2& b) {
+      return (b.x - a.x) * (p.y() - a.y) - (b.y - a.y) * (p.x() - a.x);
+    };
+    const std::vector<field::Vec2>& v = goal.vertices_m;
+    const double c0 = cross(v[0], v[1]), c1 = cross(v[1], v[2]), c2 = cross(v[2], v[0]);
+    return (c0 >= 0 && c1 >= 0 && c2 >= 0) || (c0 <= 0 && c1 <= 0 && c2 <= 0);
+  }
   const double yaw = goal.yaw_deg * kPi / 180.0;
   const double lx = std::cos(yaw) * d.x() + std::sin(yaw) * d.y();
   const double ly = -std::sin(yaw) * d.x() + std::cos(yaw) * d.y();

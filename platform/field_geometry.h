@@ -24,7 +24,14 @@ bool FootprintIsFree(const field::SeasonConfig& season, const Pose2D& pose, doub
 bool PointInBlockingStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p,
                               double clearance_m);
 
-// True when the point lies inside a goal's footprint (box with yaw, or cylinder).
+// True when an object (footprint radius, height) centred at p would overlap a structure it
+// cannot pass: one that blocks robots, or a raised one (a barrier robots pass under) whose
+// underside is lower than the object's top. Floor-level structures robots drive over (bumps,
+// pipes) do not stop objects.
+bool PointBlocksObject(const field::SeasonConfig& season, const Eigen::Vector2d& p, double radius_m,
+                       double object_height_m);
+
+// True when the point lies inside a goal's footprint (box with yaw, cylinder or triangle).
 bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p);
 
 // Where a landmark is drawn: discs and squares as plates on the inner face of the nearest wall

@@ -740,6 +740,8 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
       const Eigen::Vector2d drop =
           centre + Eigen::Vector2d(std::cos(yaw) * lx - std::sin(yaw) * ly,
                                    std::sin(yaw) * lx + std::cos(yaw) * ly);
+      // A triangle zone: the grid covers its bounding box; keep the drops inside it.
+      if (g.shape == field::SolidShape::kTriangle && !platform::GoalContains(g, drop)) continue;
       for (int k = 0; k < 4; ++k) {
         const double heading = k * kPi / 2.0;
         const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));

@@ -122,7 +122,8 @@ int Drive(const SimArgs& args) {
     return 2;
   }
   // The whole field: the robot pushes objects, opponents follow their paths.
-  platform::SimField field(season, robot, field::Alliance::kRed, args.seed, start);
+  platform::SimField field(season, robot, field::Alliance::kRed, args.seed, start,
+                           platform::SimDriveOptionsFor(robot.drive));
   const platform::SimWorld before = field.world();
   platform::SimClock clock;
   const std::vector<platform::DriveStepResult> results =

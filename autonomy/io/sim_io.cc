@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -25,8 +26,8 @@ double CalibrateOdometryScale(const field::RobotConfig& robot) {
   double ratio = 0.0;
   const int runs = 5;
   for (int i = 0; i < runs; ++i) {
-    const std::vector<platform::DriveStepResult> r =
-        platform::SimulateDriveScript("forward 1.0", robot, platform::SimDriveOptions{}, 1000 + i);
+    const std::vector<platform::DriveStepResult> r = platform::SimulateDriveScript(
+        "forward 1.0", robot, platform::SimDriveOptionsFor(robot.drive), 1000 + i);
     const double truth = std::hypot(r.back().true_pose.x_m, r.back().true_pose.y_m);
     const double encoders = std::hypot(r.back().odometry_pose.x_m, r.back().odometry_pose.y_m);
     ratio += truth / encoders;
@@ -44,7 +45,8 @@ class SimIo : public RobotIo {
     platform::SimFieldOptions options;
     options.preload = true;
     sim_ = std::make_unique<platform::SimField>(field, robot, alliance_, seed_, start,
-                                                platform::SimDriveOptions{}, options);
+                                                platform::SimDriveOptionsFor(robot.drive), options);
+    if (robot.imu) gyro_ = platform::SimGyro(seed_, platform::SimGyroOptionsFor(*robot.imu));
     renderer_ = std::make_unique<platform::SimRenderer>(field, robot.camera,
                                                         platform::RenderOptions{}, seed_);
   }
@@ -122,7 +124,14 @@ field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitte
   if (jitter_m <= 0.0) return out;
   std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + 17);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::optional<field::Vec2> stack_bottom;  // where the bottom of the current stack went
   for (field::ObjectPlacement& p : out.objects) {
+    // A stack moves as one: its upper objects follow its bottom one.
+    if (p.position_m && p.stack_level > 0) {
+      if (stack_bottom) p.position_m = stack_bottom;
+      continue;
+    }
+    stack_bottom.reset();
     if (!p.position_m || p.z_m > 0.0) continue;
     const Eigen::Vector2d nominal(p.position_m->x, p.position_m->y);
     const bool preload =
@@ -136,10 +145,11 @@ field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitte
       const Eigen::Vector2d c = nominal + jitter_m * Eigen::Vector2d(unit(rng), unit(rng));
       const double limit = season.HalfSize() - r;
       if (std::abs(c.x()) > limit || std::abs(c.y()) > limit) continue;
-      if (platform::PointInBlockingStructure(season, c, r)) continue;
+      if (platform::PointBlocksObject(season, c, r, type ? type->height_m : 0.0)) continue;
       p.position_m = field::Vec2{c.x(), c.y()};
       break;
     }
+    if (p.stack_size > 1) stack_bottom = p.position_m;
   }
   return out;
 }

@@ -134,7 +134,8 @@ void FieldCanvas::DrawFloorAndWalls() {
 void FieldCanvas::DrawStructures() {
   for (const field::Structure& s : season_.structures) {
     const cv::Scalar colour = Colour(s.colour);
-    const double alpha = s.blocks_robot ? 1.0 : 0.55;
+    // Solid: blocks robots; faded: robots drive over it; pale: robots pass under it.
+    const double alpha = s.blocks_robot ? 1.0 : s.PassUnder() ? 0.3 : 0.55;
     if (s.shape == SolidShape::kBox) {
       FillRotatedBox(s.center_m, s.size_m, s.yaw_deg, colour, alpha);
     } else {
@@ -149,7 +150,11 @@ void FieldCanvas::DrawGoals() {
   for (const field::Goal& g : season_.goals) {
     const cv::Scalar colour = AllianceColour(g.alliance);
     const cv::Point center = ToPixel(g.center_m.x, g.center_m.y);
-    if (g.shape == SolidShape::kBox && g.yaw_deg != 0.0) {
+    if (g.shape == SolidShape::kTriangle) {
+      std::vector<cv::Point> corners;
+      for (const Vec2& v : g.vertices_m) corners.push_back(ToPixel(v.x, v.y));
+      cv::polylines(image_, corners, true, colour, 2, cv::LINE_AA);
+    } else if (g.shape == SolidShape::kBox && g.yaw_deg != 0.0) {
       // A rotated goal or zone: its outline, turned.
       const double yaw = g.yaw_deg * M_PI / 180.0;
       std::vector<cv::Point> corners;
@@ -174,7 +179,8 @@ void FieldCanvas::DrawGoals() {
     }
     // Label a zone at its top-left inner corner, a goal beside it.
     const cv::Point at =
-        g.kind == field::GoalKind::kZone && g.shape == SolidShape::kBox
+        g.shape == SolidShape::kTriangle ? center + cv::Point(-20, 4)
+        : g.kind == field::GoalKind::kZone && g.shape == SolidShape::kBox
             ? ToPixel(g.center_m.x - g.size_m.x / 2.0 + 0.05, g.center_m.y + g.size_m.y / 2.0 - 0.1)
             : center + cv::Point(ToPixels(g.radius_m + g.size_m.x / 2.0) + 6, 4);
     Label(image_, g.name, at, 0.38);
@@ -260,6 +266,13 @@ void FieldCanvas::DrawObjects() {
     } else {
       cv::circle(image_, c, r, colour, cv::FILLED, cv::LINE_AA);
       cv::circle(image_, c, r, kBlack, 1, cv::LINE_AA);
+    }
+    // A stack is drawn bottom first, so its top object shows; its height beside it. An
+    // object raised on a structure says so.
+    if (p.stack_size > 1 && p.stack_level == p.stack_size - 1) {
+      Label(image_, "x" + std::to_string(p.stack_size), c + cv::Point(r - 2, -r + 2), 0.33);
+    } else if (p.stack_size == 1 && p.z_m > 0.0) {
+      Label(image_, "on top", c + cv::Point(r - 2, -r + 2), 0.33);
     }
   }
   // Region labels last, so objects do not cover them; placements sharing a region share a
@@ -355,7 +368,7 @@ void FieldCanvas::DrawLegend() {
   line("starting tile (arrow: heading)", 0.4);
   cv::rectangle(image_, cv::Point(x0 + 6, y - 12), cv::Point(x0 + 22, y), cv::Scalar(150, 150, 150),
                 cv::FILLED);
-  line("structure (faded: drivable)", 0.4);
+  line("structure (faded: drive over; pale: pass under)", 0.4);
 }
 
 cv::Mat DrawFieldPicture(const field::SeasonConfig& season, const FieldPictureOptions& options) {

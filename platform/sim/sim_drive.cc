@@ -13,6 +13,21 @@ constexpr double kTimeEpsilonS = 1e-9;
 
 }  // namespace
 
+SimDriveOptions SimDriveOptionsFor(const field::DriveConfig& drive) {
+  SimDriveOptions options;
+  if (!drive.slip) return options;
+  const field::SlipConfig& s = *drive.slip;
+  options.motor.time_constant_s = s.motor_time_constant_s;
+  options.straight_slip.mean = s.straight_mean;
+  options.straight_slip.stddev = s.straight_stddev;
+  options.differential_slip.stddev = s.side_stddev;
+  options.turn_slip.mean = s.turn_mean;
+  options.turn_slip.stddev = s.turn_stddev;
+  options.pivot_offset_m.mean = s.pivot_offset_m;
+  options.pivot_offset_m.stddev = s.pivot_stddev_m;
+  return options;
+}
+
 SimDriveBase::SimDriveBase(const field::DriveConfig& drive, const SimDriveOptions& options,
                            uint64_t seed, const Pose2D& start)
     : drive_(drive),

@@ -46,6 +46,9 @@ struct SimDriveOptions {
   SlipProcessOptions pivot_offset_m{0.07, 0.01, 3.0};
 };
 
+// The defaults above with the robot file's slip model (drive.slip) when it has one.
+SimDriveOptions SimDriveOptionsFor(const field::DriveConfig& drive);
+
 class SimDriveBase : public DriveBase {
  public:
   SimDriveBase(const field::DriveConfig& drive, const SimDriveOptions& options, uint64_t seed,

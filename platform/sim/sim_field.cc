@@ -57,7 +57,40 @@ void SimField::Step(double dt_s) {
   drive_.Step(dt_s);
   PushOut(drive_.true_pose(), robot_.length_m, robot_.width_m);
   for (size_t i = 0; i < world_.opponents.size(); ++i) StepOpponent(i, dt_s);
+  Settle();
   time_s_ += dt_s;
+}
+
+void SimField::Settle() {
+  // Lowest first, so a whole stack comes down in one pass.
+  std::vector<SimObject*> raised;
+  for (SimObject& o : world_.objects) {
+    if (!o.held && o.in_goal < 0 && o.center_m.z() - o.type->height_m / 2.0 > 1e-3) {
+      raised.push_back(&o);
+    }
+  }
+  std::sort(raised.begin(), raised.end(), [](const SimObject* a, const SimObject* b) {
+    return a->center_m.z() < b->center_m.z();
+  });
+  for (SimObject* o : raised) {
+    const double bottom = o->center_m.z() - o->type->height_m / 2.0;
+    const Vector2d xy = o->center_m.head<2>();
+    double support = 0.0;
+    for (const SimObject& other : world_.objects) {
+      if (&other == o || other.held || other.in_goal >= 0) continue;
+      const double top = other.center_m.z() + other.type->height_m / 2.0;
+      const double reach = 0.5 * std::max(o->type->size_m, other.type->size_m);
+      if (top <= bottom + 1e-3 && (other.center_m.head<2>() - xy).norm() < reach) {
+        support = std::max(support, top);
+      }
+    }
+    for (const field::Structure& s : season_.structures) {
+      if (s.height_m <= bottom + 1e-3 && DistanceToStructure(s, xy) <= 0.0) {
+        support = std::max(support, s.height_m);
+      }
+    }
+    if (support < bottom - 1e-3) o->center_m.z() = support + o->type->height_m / 2.0;
+  }
 }
 
 bool SimField::RobotPoseIsFree(const Pose2D& pose) const {
@@ -117,7 +150,7 @@ std::optional<Vector2d> SimField::PushedPosition(const SimObject& object, const 
     const Vector2d world(pose.x_m + c * in_robot.x() - s * in_robot.y(),
                          pose.y_m + s * in_robot.x() + c * in_robot.y());
     if (std::abs(world.x()) > limit || std::abs(world.y()) > limit) return std::nullopt;
-    if (PointInBlockingStructure(season_, world, r)) return std::nullopt;
+    if (PointBlocksObject(season_, world, r, object.type->height_m)) return std::nullopt;
     return world;
   };
   if (const auto world = valid(pushed)) return world;
@@ -191,6 +224,7 @@ std::optional<int> SimField::Pick() {
   if (!best) return std::nullopt;
   best->held = true;
   held_.push_back(best->id);
+  Settle();
   return best->id;
 }
 
@@ -236,7 +270,7 @@ std::optional<ReleaseResult> SimField::Release() {
   if (o.in_goal < 0) {
     const double limit = season_.HalfSize() - r;
     if (std::abs(drop.x()) > limit || std::abs(drop.y()) > limit ||
-        PointInBlockingStructure(season_, drop, r)) {
+        PointBlocksObject(season_, drop, r, o.type->height_m)) {
       return std::nullopt;  // no room in front: keep holding it
     }
     o.center_m = Eigen::Vector3d(drop.x(), drop.y(), o.type->height_m / 2.0);

@@ -74,6 +74,9 @@ class SimField {
   // cannot go anywhere free.
   bool CanPushOut(const Pose2D& pose, double length_m, double width_m) const;
   void PushOut(const Pose2D& pose, double length_m, double width_m);
+  // Objects whose support went (the object below a stack picked or pushed away) drop onto
+  // what is now under them: another object, a structure's top, or the floor.
+  void Settle();
   std::optional<Eigen::Vector2d> PushedPosition(const SimObject& object, const Pose2D& pose,
                                                 double length_m, double width_m) const;
   void StepOpponent(size_t index, double dt_s);

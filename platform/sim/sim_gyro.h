@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <random>
 
+#include "field_configs/robot_config.h"
 #include "platform/drive_base.h"
 
 namespace slamo::platform {
@@ -16,6 +17,11 @@ struct SimGyroOptions {
   double noise_rad = 0.2 * kPi / 180.0;             // white noise of one reading
   double drift_rad_per_sqrt_s = 0.1 * kPi / 180.0;  // bias random walk
 };
+
+// The robot file's inertial sensor (imu:) as gyro options.
+inline SimGyroOptions SimGyroOptionsFor(const field::ImuConfig& imu) {
+  return {imu.noise_deg * kPi / 180.0, imu.drift_deg_per_sqrt_s * kPi / 180.0};
+}
 
 class SimGyro {
  public:

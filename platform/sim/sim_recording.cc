@@ -21,7 +21,8 @@ SimRecordingSummary RecordSimulatedRun(
                          std::to_string(options.encoder_rate_hz));
   }
   const std::vector<DriveStep> steps = ParseDriveScript(options.script);
-  SimField field(season, robot, field::Alliance::kRed, options.seed, options.start);
+  SimField field(season, robot, field::Alliance::kRed, options.seed, options.start,
+                 SimDriveOptionsFor(robot.drive));
   SimRenderer renderer(season, robot.camera, options.render, options.seed);
   SimClock clock;
   SimRecordingSummary summary;
