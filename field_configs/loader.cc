@@ -412,7 +412,8 @@ class SeasonParser {
 namespace {
 
 void ParseRobot(const YamlReader& root, RobotConfig* robot) {
-  root.AllowKeys({"name", "footprint", "mass_kg", "drive", "intake", "camera", "imu"});
+  root.AllowKeys(
+      {"name", "footprint", "mass_kg", "drive", "intake", "camera", "imu", "odometry_noise"});
   robot->name = root.Required("name").String();
   const YamlReader footprint = root.Required("footprint");
   footprint.AllowKeys({"length_m", "width_m", "height_m"});
@@ -566,6 +567,17 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
     i.drift_deg_per_sqrt_s = imu->Required("drift_deg_per_sqrt_s").InRange(0.0, 10.0);
     robot->imu = i;
   }
+
+  const YamlReader odometry = root.Required("odometry_noise");
+  odometry.AllowKeys({"forward_sigma_per_m", "lateral_sigma_per_m", "forward_sigma_per_rad",
+                      "lateral_sigma_per_rad", "heading_sigma_per_rad", "heading_sigma_per_m"});
+  OdometryNoiseConfig& n = robot->odometry_noise;
+  n.forward_sigma_per_m = odometry.Required("forward_sigma_per_m").InRange(0.0, 5.0);
+  n.lateral_sigma_per_m = odometry.Required("lateral_sigma_per_m").InRange(0.0, 5.0);
+  n.forward_sigma_per_rad = odometry.Required("forward_sigma_per_rad").InRange(0.0, 5.0);
+  n.lateral_sigma_per_rad = odometry.Required("lateral_sigma_per_rad").InRange(0.0, 5.0);
+  n.heading_sigma_per_rad = odometry.Required("heading_sigma_per_rad").InRange(0.0, 5.0);
+  n.heading_sigma_per_m = odometry.Required("heading_sigma_per_m").InRange(0.0, 5.0);
 }
 
 std::vector<std::string> ListYamlStems(const fs::path& dir) {

@@ -76,6 +76,17 @@ struct ImuConfig {
   double drift_deg_per_sqrt_s = 0.1;  // bias random walk
 };
 
+// The odometry's error, as SLAM-O's EKF models it: sigmas growing with the distance travelled
+// and the angle turned in one step (mapping::MotionNoise).
+struct OdometryNoiseConfig {
+  double forward_sigma_per_m = 0.0;    // forward error per metre travelled
+  double lateral_sigma_per_m = 0.0;    // sideways error per metre travelled
+  double forward_sigma_per_rad = 0.0;  // forward error per radian turned (turn slip)
+  double lateral_sigma_per_rad = 0.0;  // sideways error per radian turned
+  double heading_sigma_per_rad = 0.0;  // heading error per radian turned
+  double heading_sigma_per_m = 0.0;    // heading error per metre travelled
+};
+
 // Depth noise: standard deviation of one depth reading by distance, interpolated linearly.
 struct DepthNoise {
   std::vector<double> distance_m;
@@ -129,6 +140,7 @@ struct RobotConfig {
   IntakeConfig intake;
   CameraConfig camera;
   std::optional<ImuConfig> imu;
+  OdometryNoiseConfig odometry_noise;
 };
 
 }  // namespace slamo::field

@@ -90,6 +90,17 @@ Eigen::Matrix3d EkfSlam::MotionCovariance(const OdometryStep& u) const {
   return MotionModelCovariance(options_.motion, u);
 }
 
+MotionNoise MotionNoiseFor(const field::OdometryNoiseConfig& odometry) {
+  MotionNoise m;
+  m.sigma_per_m = odometry.forward_sigma_per_m;
+  m.lateral_sigma_per_m = odometry.lateral_sigma_per_m;
+  m.forward_sigma_per_rad = odometry.forward_sigma_per_rad;
+  m.lateral_sigma_per_rad = odometry.lateral_sigma_per_rad;
+  m.heading_sigma_per_rad = odometry.heading_sigma_per_rad;
+  m.heading_sigma_per_m = odometry.heading_sigma_per_m;
+  return m;
+}
+
 Eigen::Matrix3d MotionModelCovariance(const MotionNoise& m, const OdometryStep& u) {
   const double distance = std::hypot(u.dx_m, u.dy_m);
   const double turn = std::abs(u.dtheta_rad);

@@ -18,6 +18,8 @@
 
 #include <Eigen/Dense>
 
+#include "field_configs/robot_config.h"
+
 namespace slamo::mapping {
 
 // Odometry increment in the robot frame at the start of the step.
@@ -48,6 +50,9 @@ struct MotionNoise {
   double floor_m = 1e-4;                 // keeps Q positive definite when standing still
   double floor_rad = 1e-4;
 };
+
+// The motion model of the robot file's odometry_noise (the numerical floor stays the default).
+MotionNoise MotionNoiseFor(const field::OdometryNoiseConfig& odometry);
 
 // The covariance of the increment `u` (dx, dy, dtheta) under the motion model `noise`: sigmas
 // growing with the distance travelled and the angle turned.

@@ -69,6 +69,10 @@ WaypointsRun RunRoute(const field::SeasonConfig& field, const field::RobotConfig
   // own measurement model.
   mapping::SlamOOptions options;
   options.ekf = setup.ekf;
+  if (setup.motion_from_robot) {
+    options.ekf.motion = mapping::MotionNoiseFor(robot.odometry_noise);
+    options.ekf.max_range_m = robot.camera.max_range_m;
+  }
   options.stop_bias_covariance = setup.bias_covariance;
   options.white_covariance = setup.white_covariance;
   options.iterate_frames = setup.iterate;

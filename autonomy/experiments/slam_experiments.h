@@ -25,6 +25,8 @@ struct WaypointsSetup {
   double stop_spacing_m = 0.3;
   mapping::FrameSelectionOptions frames;
   mapping::EkfOptions ekf;
+  // The filter's motion noise and range from the robot file (true), or `ekf`'s as given.
+  bool motion_from_robot = true;
   Eigen::Matrix2d bias_covariance = Eigen::Matrix2d::Zero();  // per-stop measurement bias
   // Per-frame (white) measurement covariance; zero: vision's own estimate for each detection.
   Eigen::Matrix2d white_covariance = Eigen::Matrix2d::Zero();

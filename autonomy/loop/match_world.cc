@@ -67,7 +67,10 @@ mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::Robot
   prior.covariance = Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal();
   prior.surveyed_markers = platform::SurveyedMarkers(field);
   prior.marker_sigma_m = 1e-3;
+  // The filter from the robot file: its odometry's noise, its camera's range.
   mapping::SlamOOptions options;
+  options.ekf.motion = mapping::MotionNoiseFor(robot.odometry_noise);
+  options.ekf.max_range_m = robot.camera.max_range_m;
   options.ekf.add_landmarks = false;
   options.relocalise = relocalise;
   return mapping::SlamO(field, robot.camera, prior, options);
