@@ -346,8 +346,8 @@ void RegisterReplayCommand(CLI::App& app, CommandAction* action) {
   replay->add_option("--bearing-sigma-deg", f->bearing_sigma_deg,
                      "every measurement's bearing sigma, degrees (default: the log's)");
   replay->add_option("--max-range", f->max_range_m,
-                     "measurements beyond this are ignored, m "
-                     "(default 4.5)");
+                     "measurements beyond this are ignored, m (default: the log's sensor range "
+                     "where it gives one, else 4.5)");
   replay->add_option("--fov-deg", f->fov_deg,
                      "field of view: measurements beyond +-fov/2 are dropped (default: all)");
   replay->add_option("--gate-prob", f->gate_probability,
