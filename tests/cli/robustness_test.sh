@@ -1,0 +1,16 @@
+#!/bin/sh
+# slamo experiment robustness on MRPT's simul-landmarks logs (one run a row): the table has a
+# slamo and an MRPT line for each of the nine noise rows, and where the noise is what both
+# filters are told, slamo's map and trajectory are within a centimetre of the truth.
+set -eu
+slamo="$1"
+dir="$2"
+rm -rf "$dir"
+"$slamo" experiment robustness --runs 1 --out "$dir/logs" > "$dir.txt" 2> /dev/null
+rows=$(grep -cE '^[0-9.]+x +[0-9.]+x +(slamo|mrpt) ' "$dir.txt")
+test "$rows" -eq 18 || { echo "expected 18 table rows, got $rows"; cat "$dir.txt"; exit 1; }
+awk '$1 == "1.00x" && $2 == "1.00x" && $3 == "slamo" {
+       found = 1
+       if (!($4 < 0.01 && $5 < 0.01)) { print "1x/1x: landmark RMSE " $4 ", ATE " $5; bad = 1 }
+     }
+     END { if (!found) { print "no 1x/1x slamo row"; exit 1 } exit bad }' "$dir.txt"
