@@ -20,7 +20,14 @@ double Wrap(double a) {
 }
 
 // Keeps P symmetric after every operation (round-off breaks it slowly otherwise).
-void Symmetrise(Eigen::MatrixXd* p) { *p = 0.5 * (*p + p->transpose()); }
+// Averages P with its transpose, in place (`P = 0.5 (P + P^T)` would read entries it has already
+// written: Eigen does not guard that alias).
+void Symmetrise(Eigen::MatrixXd* p) {
+  Eigen::MatrixXd& m = *p;
+  for (Eigen::Index c = 1; c < m.cols(); ++c) {
+    for (Eigen::Index r = 0; r < c; ++r) m(r, c) = m(c, r) = 0.5 * (m(r, c) + m(c, r));
+  }
+}
 
 // The regularised lower incomplete gamma function P(a, x) (series below a + 1, continued
 // fraction above; Numerical Recipes 6.2), the chi-square CDF being P(dof / 2, x / 2).
@@ -174,30 +181,31 @@ double EkfSlam::Mahalanobis2(const RangeBearing& z, int index) const {
 }
 
 double EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
-  const int n = static_cast<int>(x_.size());
   const int j = 3 + 2 * index;
   Eigen::Matrix<double, 2, 3> h_pose;
   Eigen::Matrix2d h_l;
   ObserveJacobians(x_.head<3>(), landmark(index), &h_pose, &h_l);
-  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2, n);
-  h.leftCols<3>() = h_pose;
-  h.block<2, 2>(0, j) = h_l;
   // Only the pose and this landmark's columns of H are non-zero: P H^T from those.
-  const Eigen::MatrixXd pht =
-      p_.leftCols<3>() * h_pose.transpose() + p_.middleCols<2>(j) * h_l.transpose();
-  const Eigen::Matrix2d s =
-      h.middleCols<3>(0) * pht.topRows<3>() + h_l * pht.middleRows<2>(j) + z.covariance;
-  const Eigen::MatrixXd k = pht * s.inverse();
+  pht_.noalias() = p_.leftCols<3>() * h_pose.transpose();
+  pht_.noalias() += p_.middleCols<2>(j) * h_l.transpose();
+  const Eigen::Matrix2d s = h_pose * pht_.topRows<3>() + h_l * pht_.middleRows<2>(j) + z.covariance;
+  gain_.noalias() = pht_ * s.inverse();
   Eigen::Vector2d e =
       Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(x_.head<3>(), landmark(index));
   e.y() = Wrap(e.y());
-  x_ += k * e;
+  x_.noalias() += gain_ * e;
   x_(2) = Wrap(x_(2));
-  // Joseph form: P = (I - K H) P (I - K H)^T + K R K^T.
-  Eigen::MatrixXd ikh = -k * h;
-  ikh.diagonal().array() += 1.0;
-  p_ = ikh * p_ * ikh.transpose() + k * z.covariance * k.transpose();
-  Symmetrise(&p_);
+  // Joseph form (I - K H) P (I - K H)^T + K R K^T, multiplied out so that no n x n x n product
+  // is formed: P - K (H P) - (H P)^T K^T + K S K^T, with H P = (P H^T)^T. Each term is an outer
+  // product of n x 2 factors (O(n^2)); the sum keeps the Joseph form's tolerance of a gain that
+  // is not exactly optimal. One pass over the upper triangle, mirrored: P stays exactly symmetric.
+  gain_s_.noalias() = gain_ * s;
+  for (Eigen::Index c = 0; c < p_.cols(); ++c) {
+    for (Eigen::Index r = 0; r <= c; ++r) {
+      p_(r, c) = p_(c, r) = p_(r, c) - gain_.row(r).dot(pht_.row(c)) -
+                            pht_.row(r).dot(gain_.row(c)) + gain_s_.row(r).dot(gain_.row(c));
+    }
+  }
   const double nis = e.dot(s.ldlt().solve(e));
   counters_.nis_sum += nis;
   ++counters_.nis_count;
@@ -357,10 +365,17 @@ std::vector<int> EkfSlam::JointCompatibility(const std::vector<RangeBearing>& fr
     }
   }
   // Joint Mahalanobis distance of a hypothesis (pairs measurement -> landmark).
+  // S = H P H^T + R over the pose and the paired landmarks only (H is zero elsewhere).
   const Eigen::Vector3d pose = x_.head<3>();
-  const int size = static_cast<int>(x_.size());
   const auto joint_d2 = [&](const std::vector<std::pair<int, int>>& pairs) {
     const int k = static_cast<int>(pairs.size());
+    const int size = 3 + 2 * k;
+    std::vector<int> rows = {0, 1, 2};
+    for (const auto& pair : pairs)
+      rows.insert(rows.end(), {3 + 2 * pair.second, 4 + 2 * pair.second});
+    Eigen::MatrixXd p_sub(size, size);
+    for (int a = 0; a < size; ++a)
+      for (int b = 0; b < size; ++b) p_sub(a, b) = p_(rows[a], rows[b]);
     Eigen::VectorXd e(2 * k);
     Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2 * k, size);
     Eigen::MatrixXd r = Eigen::MatrixXd::Zero(2 * k, 2 * k);
@@ -370,14 +385,14 @@ std::vector<int> EkfSlam::JointCompatibility(const std::vector<RangeBearing>& fr
       Eigen::Matrix2d h_l;
       ObserveJacobians(pose, landmark(j), &h_pose, &h_l);
       h.block<2, 3>(2 * p, 0) = h_pose;
-      h.block<2, 2>(2 * p, 3 + 2 * j) = h_l;
+      h.block<2, 2>(2 * p, 3 + 2 * p) = h_l;
       Eigen::Vector2d d =
           Eigen::Vector2d(frame[i].range_m, frame[i].bearing_rad) - Observe(pose, landmark(j));
       d.y() = Wrap(d.y());
       e.segment<2>(2 * p) = d;
       r.block<2, 2>(2 * p, 2 * p) = frame[i].covariance;
     }
-    const Eigen::MatrixXd s = h * p_ * h.transpose() + r;
+    const Eigen::MatrixXd s = h * p_sub * h.transpose() + r;
     return e.dot(s.ldlt().solve(e));
   };
   // Depth-first branch and bound over the measurements.

@@ -190,6 +190,7 @@ class EkfSlam {
   EkfOptions options_;
   Eigen::VectorXd x_;
   Eigen::MatrixXd p_;
+  Eigen::Matrix<double, Eigen::Dynamic, 2> pht_, gain_, gain_s_;  // update scratch, kept sized
   std::vector<int> ids_;
   std::vector<std::string> signatures_;
   FilterCounters counters_;

@@ -136,6 +136,44 @@ TEST(EkfSlamTest, NeesInsideTheBandOverSeeds) {
   EXPECT_LT(mean, 4.5);
 }
 
+// The update multiplies the Joseph form out to stay O(n^2): it must equal the textbook
+// (I - K H) P (I - K H)^T + K R K^T on a map whose landmarks are correlated with the pose.
+TEST(EkfSlamTest, UpdateEqualsTheFullJosephForm) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  EkfSlam ekf(Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Matrix3d::Identity() * 1e-2);
+  const Eigen::Matrix2d r = Eigen::Vector2d(4e-4, 3e-4).asDiagonal();
+  for (int id = 0; id < 10; ++id) {
+    ekf.Update({1.0 + 0.2 * id, -1.2 + 0.25 * id, r, id, "marker"});
+    ekf.Predict(OdometryStep{0.05, 0.01, 0.02});
+  }
+  for (int trial = 0; trial < 20; ++trial) {
+    const int index = trial % ekf.landmark_count();
+    const Eigen::MatrixXd p = ekf.covariance();
+    const Eigen::VectorXd x = ekf.state();
+    const Eigen::Vector2d z = EkfSlam::Observe(x.head<3>(), ekf.landmark(index)) +
+                              Eigen::Vector2d(0.01 * n01(rng), 0.01 * n01(rng));
+    // The textbook update, with dense matrices.
+    Eigen::Matrix<double, 2, 3> h_pose;
+    Eigen::Matrix2d h_l;
+    EkfSlam::ObserveJacobians(x.head<3>(), ekf.landmark(index), &h_pose, &h_l);
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2, x.size());
+    h.leftCols<3>() = h_pose;
+    h.block<2, 2>(0, 3 + 2 * index) = h_l;
+    const Eigen::MatrixXd k = p * h.transpose() * (h * p * h.transpose() + r).inverse();
+    const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(x.size(), x.size()) - k * h;
+    const Eigen::MatrixXd expected = ikh * p * ikh.transpose() + k * r * k.transpose();
+
+    ASSERT_EQ(ekf.Update({z.x(), z.y(), r, ekf.landmark_id(index), "marker"}),
+              UpdateOutcome::kUpdated);
+    const Eigen::MatrixXd& got = ekf.covariance();
+    EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-12 * p.cwiseAbs().maxCoeff())
+        << "trial " << trial;
+    EXPECT_EQ((got - got.transpose()).cwiseAbs().maxCoeff(), 0.0);  // exactly symmetric
+    EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(got).eigenvalues().minCoeff(), 0.0);
+  }
+}
+
 TEST(EkfSlamTest, NearestNeighbourAssociationMakesNoDuplicates) {
   Simulation sim;
   std::mt19937_64 rng(7);
