@@ -118,6 +118,7 @@ Eigen::Matrix3d MotionModelCovariance(const MotionNoise& m, const OdometryStep& 
 }
 
 void EkfSlam::Predict(const OdometryStep& u) {
+  if (options_.adaptive.enabled) CheckStep();
   Eigen::Matrix3d f_pose, f_u;
   x_.head<3>() = Move(x_.head<3>(), u, &f_pose, &f_u);
   // P = F P F^T + G Q G^T, touching only the pose rows and columns.
@@ -130,6 +131,7 @@ void EkfSlam::Predict(const OdometryStep& u) {
     p_.bottomLeftCorner(n - 3, 3) = p_.topRightCorner(3, n - 3).transpose();
   }
   Symmetrise(&p_);
+  if (options_.adaptive.enabled) prior_ = Prior{x_.head<3>(), p_.topLeftCorner<3, 3>()};
 }
 
 Eigen::Vector2d EkfSlam::Observe(const Eigen::Vector3d& pose, const Eigen::Vector2d& landmark) {
@@ -174,7 +176,7 @@ double EkfSlam::Mahalanobis2(const RangeBearing& z, int index) const {
   const Eigen::Matrix2d s = h_pose * p_.topLeftCorner<3, 3>() * h_pose.transpose() +
                             h_pose * p_.block<3, 2>(0, j) * h_l.transpose() +
                             h_l * p_.block<2, 3>(j, 0) * h_pose.transpose() +
-                            h_l * p_.block<2, 2>(j, j) * h_l.transpose() + z.covariance;
+                            h_l * p_.block<2, 2>(j, j) * h_l.transpose() + NoiseOf(z);
   Eigen::Vector2d e = Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(pose, l);
   e.y() = Wrap(e.y());
   return e.dot(s.ldlt().solve(e));
@@ -188,7 +190,7 @@ double EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
   // Only the pose and this landmark's columns of H are non-zero: P H^T from those.
   pht_.noalias() = p_.leftCols<3>() * h_pose.transpose();
   pht_.noalias() += p_.middleCols<2>(j) * h_l.transpose();
-  const Eigen::Matrix2d s = h_pose * pht_.topRows<3>() + h_l * pht_.middleRows<2>(j) + z.covariance;
+  const Eigen::Matrix2d s = h_pose * pht_.topRows<3>() + h_l * pht_.middleRows<2>(j) + NoiseOf(z);
   gain_.noalias() = pht_ * s.inverse();
   Eigen::Vector2d e =
       Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(x_.head<3>(), landmark(index));
@@ -215,7 +217,7 @@ double EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
 
 void EkfSlam::RecordNis(double nis) {
   const AdaptiveOptions& a = options_.adaptive;
-  if (!a.enabled) return;
+  if (!a.enabled || step_checks_) return;  // the step checks decide (CheckStep)
   nis_window_.push_back(std::min(nis, a.nis_cap));
   if (static_cast<int>(nis_window_.size()) < a.window) return;
   double mean = 0.0;
@@ -233,6 +235,95 @@ void EkfSlam::RecordNis(double nis) {
     if (q_scale_ == 1.0) in_episode_ = false;
   }
   nis_window_.clear();
+}
+
+void EkfSlam::CheckStep() {
+  const AdaptiveOptions& a = options_.adaptive;
+  const int m = static_cast<int>(step_seen_.size());
+  if (m < 2) {
+    step_seen_.clear();
+    return;
+  }
+  // The pose that best explains this step's measurements alone (Gauss-Newton from the
+  // estimate), against the landmarks as they were before these measurements updated them (so
+  // that the residual is not shrunk by its own update); each measurement weighted by its noise
+  // and its landmark's uncertainty.
+  Eigen::Vector3d pose = x_.head<3>();
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  double chi2 = 0.0;
+  for (int iteration = 0; iteration < 6; ++iteration) {
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    information.setZero();
+    chi2 = 0.0;
+    for (const Seen& seen : step_seen_) {
+      Eigen::Matrix<double, 2, 3> h_pose;
+      Eigen::Matrix2d h_l;
+      ObserveJacobians(pose, seen.landmark, &h_pose, &h_l);
+      const Eigen::Matrix2d w =
+          (NoiseOf(seen.z) + h_l * seen.covariance * h_l.transpose()).inverse();
+      Eigen::Vector2d e =
+          Eigen::Vector2d(seen.z.range_m, seen.z.bearing_rad) - Observe(pose, seen.landmark);
+      e.y() = Wrap(e.y());
+      information += h_pose.transpose() * w * h_pose;
+      b += h_pose.transpose() * w * e;
+      chi2 += e.dot(w * e);
+    }
+    const Eigen::Vector3d delta = information.ldlt().solve(b);
+    if (!delta.allFinite()) {
+      step_seen_.clear();
+      return;
+    }
+    pose += delta;
+    pose.z() = Wrap(pose.z());
+    if (delta.norm() < 1e-9) break;
+  }
+  step_seen_.clear();
+  step_checks_ = true;
+  // The sensor: the fit's residual, 2m - 3 degrees of freedom.
+  const int dof = 2 * m - 3;
+  window_.residual_chi2 += std::min(chi2, 0.5 * a.nis_cap * dof);  // outliers count at most this
+  window_.residual_dof += dof;
+  // The motion: the step's predicted pose against the fit, 3 degrees of freedom.
+  if (prior_) {
+    Eigen::Vector3d d = pose - prior_->pose;
+    d.z() = Wrap(d.z());
+    const Eigen::Matrix3d c = prior_->covariance + information.inverse();
+    window_.pose_chi2 += std::min(d.dot(c.ldlt().solve(d)), 1.5 * a.nis_cap);
+    window_.pose_dof += 3;
+  }
+  ++window_.steps;
+  // Decide at the window's end, or at once on overwhelming evidence: a bound passed by chance
+  // once in a million checks (each step checks, so a lower bound would raise false alarms).
+  const double kOverwhelming = 1.0 - 1e-6;
+  const bool sensor_overwhelming =
+      window_.residual_chi2 > Chi2Quantile(kOverwhelming, window_.residual_dof);
+  const bool motion_overwhelming =
+      window_.pose_dof > 0 && window_.pose_chi2 > Chi2Quantile(kOverwhelming, window_.pose_dof);
+  if (window_.steps < a.sensor_window && !sensor_overwhelming && !motion_overwhelming) return;
+  const StepWindow w = window_;
+  window_ = StepWindow{};
+  const double ratio = w.residual_chi2 / w.residual_dof;
+  sensor_suspect_ = ratio > Chi2Quantile(0.975, w.residual_dof) / w.residual_dof;
+  if (sensor_suspect_) {
+    ++counters_.sensor_episodes;
+    const double growth = std::min(a.max_scale / r_scale_, ratio);
+    r_scale_ *= growth;
+    // What the filter believes came from measurements whose noise was understated by
+    // `growth`: widen the whole belief by as much (conservative where motion dominated it).
+    p_ *= growth;
+    return;  // the pose test used the understated noise too: no verdict on the motion
+  }
+  if (w.pose_dof == 0) return;
+  const double pose_ratio = w.pose_chi2 / w.pose_dof;
+  if (pose_ratio > Chi2Quantile(0.975, w.pose_dof) / w.pose_dof) {
+    // The prediction keeps missing what the measurements say: more process noise.
+    if (!in_episode_) ++counters_.adaptive_episodes;
+    in_episode_ = true;
+    q_scale_ = std::min(a.max_scale, q_scale_ * a.growth);
+  } else if (pose_ratio < 1.0 && q_scale_ > 1.0) {
+    q_scale_ = std::max(1.0, q_scale_ / a.growth);
+    if (q_scale_ == 1.0) in_episode_ = false;
+  }
 }
 
 void EkfSlam::WidenPose(double factor) {
@@ -273,7 +364,7 @@ int EkfSlam::AddLandmark(const RangeBearing& z) {
   grown.block(n, 0, 2, n) = g_pose * p_.topRows<3>();
   grown.block(0, n, n, 2) = grown.block(n, 0, 2, n).transpose();
   grown.block<2, 2>(n, n) =
-      g_pose * p_.topLeftCorner<3, 3>() * g_pose.transpose() + g_z * z.covariance * g_z.transpose();
+      g_pose * p_.topLeftCorner<3, 3>() * g_pose.transpose() + g_z * NoiseOf(z) * g_z.transpose();
   p_ = std::move(grown);
   Symmetrise(&p_);
   ids_.push_back(z.id);
@@ -304,6 +395,7 @@ UpdateOutcome EkfSlam::Associate(const RangeBearing& z) {
   if (z.id >= 0) {
     for (int i = 0; i < landmark_count(); ++i) {
       if (ids_[i] != z.id) continue;
+      if (options_.adaptive.enabled) step_seen_.push_back({z, landmark(i), landmark_covariance(i)});
       const double d2 = Mahalanobis2(z, i);
       if (d2 <= options_.association.new_chi2) {
         ApplyUpdate(z, i);
@@ -390,7 +482,7 @@ std::vector<int> EkfSlam::JointCompatibility(const std::vector<RangeBearing>& fr
           Eigen::Vector2d(frame[i].range_m, frame[i].bearing_rad) - Observe(pose, landmark(j));
       d.y() = Wrap(d.y());
       e.segment<2>(2 * p) = d;
-      r.block<2, 2>(2 * p, 2 * p) = frame[i].covariance;
+      r.block<2, 2>(2 * p, 2 * p) = NoiseOf(frame[i]);
     }
     const Eigen::MatrixXd s = h * p_sub * h.transpose() + r;
     return e.dot(s.ldlt().solve(e));

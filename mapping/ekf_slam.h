@@ -81,6 +81,22 @@ struct AssociationOptions {
 // known-id measurements in a row fail the gate, the pose is widened (its rows and columns of P
 // scaled so that the failing innovation would sit inside the gate) and the measurement tried
 // again; a pairing then ends the lost state (re-acquired).
+// Which noise is wrong: a large innovation says the prediction and the measurement disagree,
+// not whether the motion or the sensor noise was understated. The measurements of one step
+// tell them apart: a pose error is common to all of them, sensor noise is not. So at the end
+// of each step (the next Predict), when two or more known landmarks were measured, the pose is
+// fitted to those measurements alone, the prior ignored (the snapshot least-squares residual
+// test of GPS integrity monitoring, RAIM: Parkinson and Axelrad 1988). Its residual
+// chi-square (2m - 3 degrees of freedom) does not depend on the motion noise; the predicted
+// pose against the fitted one (3 degrees of freedom) tests the motion. Over `sensor_window`
+// such steps, or at once when a bound passed by chance once in a million checks is passed:
+//   - a residual above its 97.5 % band scales the measurement noise by the residual-to-
+//     expected ratio (covariance matching of R; Mohamed and Schwarz 1999) and the whole
+//     covariance by as much (it was built from measurements trusted too much); the sensor's
+//     noise is a property of the sensor, so the scale is never lowered again (a sensor told
+//     noisier than it is only makes the filter conservative);
+//   - otherwise the pose test raises or lowers the process noise as the NIS window does.
+// With step checks the NIS window no longer decides the process noise.
 struct AdaptiveOptions {
   bool enabled = false;
   int window = 20;         // measurements per NIS window
@@ -88,6 +104,7 @@ struct AdaptiveOptions {
   double max_scale = 1e3;  // the process noise is never scaled beyond this
   int lost_after = 3;      // known-id gate failures in a row before the pose is widened
   double nis_cap = 100.0;  // one measurement's NIS counts at most this much in the window
+  int sensor_window = 10;  // steps (with >= 2 known landmarks seen) per sensor-noise window
 };
 
 // What the filter did, over its life.
@@ -98,6 +115,7 @@ struct FilterCounters {
   int rejected = 0;
   int reacquired = 0;         // updates that ended a lost state after the pose was widened
   int adaptive_episodes = 0;  // times the process noise was raised from its nominal level
+  int sensor_episodes = 0;    // times the measurement noise was raised
   double nis_sum = 0.0;       // NIS of the measurements that updated the filter
   int nis_count = 0;
   double MeanNis() const { return nis_count ? nis_sum / nis_count : 0.0; }
@@ -143,6 +161,8 @@ class EkfSlam {
   const EkfOptions& options() const { return options_; }
   // The process-noise scale now (1: nominal) and whether known markers keep failing the gate.
   double process_noise_scale() const { return q_scale_; }
+  // The measurement-noise scale now (1: the measurements' own covariance).
+  double measurement_noise_scale() const { return r_scale_; }
   bool lost() const { return lost_; }
   int landmark_count() const { return static_cast<int>(ids_.size()); }
   Eigen::Vector2d landmark(int index) const { return x_.segment<2>(3 + 2 * index); }
@@ -183,6 +203,12 @@ class EkfSlam {
   int AddLandmark(const RangeBearing& z);
   // The adaptive scheme's bookkeeping for one measurement's NIS (AdaptiveOptions).
   void RecordNis(double nis);
+  // The covariance the filter uses for a measurement: its own, times the adaptive scale.
+  Eigen::Matrix2d NoiseOf(const RangeBearing& z) const {
+    return r_scale_ == 1.0 ? z.covariance : Eigen::Matrix2d(z.covariance * r_scale_);
+  }
+  // The sensor-noise check of the step that just ended (AdaptiveOptions), then a new step.
+  void CheckStep();
   // Widens the pose by `factor` (its rows and columns of P by sqrt(factor)).
   void WidenPose(double factor);
   UpdateOutcome Count(UpdateOutcome outcome);
@@ -197,6 +223,27 @@ class EkfSlam {
   std::deque<double> nis_window_;
   double q_scale_ = 1.0;
   bool in_episode_ = false;
+  // Sensor-noise check: this step's known-landmark measurements, the window's sums.
+  // A known landmark seen in this step, as the filter knew it before the measurement.
+  struct Seen {
+    RangeBearing z;
+    Eigen::Vector2d landmark;
+    Eigen::Matrix2d covariance;
+  };
+  std::vector<Seen> step_seen_;
+  struct Prior {
+    Eigen::Vector3d pose;
+    Eigen::Matrix3d covariance;
+  };
+  std::optional<Prior> prior_;  // the step's predicted pose
+  struct StepWindow {
+    double residual_chi2 = 0.0, pose_chi2 = 0.0;
+    int residual_dof = 0, pose_dof = 0, steps = 0;
+  };
+  StepWindow window_;
+  bool step_checks_ = false;  // steps with >= 2 known landmarks seen: they decide Q, not NIS
+  double r_scale_ = 1.0;
+  bool sensor_suspect_ = false;
   int known_failures_ = 0;  // known-id gate failures in a row
   bool lost_ = false;
 };

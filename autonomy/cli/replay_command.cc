@@ -260,10 +260,11 @@ int Run(const ReplayArgs& cli) {
       args.log.c_str(), trajectory.size(), measurements, c.updated, c.added, c.ambiguous,
       c.rejected, known, known_rejected, known ? 100.0 * known_rejected / known : 0.0);
   std::printf(
-      "filter: %s; re-acquired %d, adaptive-noise episodes %d, process-noise scale now %.3g, "
-      "mean NIS %.2f (2 expected)\n",
+      "filter: %s; re-acquired %d, adaptive-noise episodes %d (process) and %d (sensor), "
+      "noise scale now %.3g (process) and %.3g (sensor), mean NIS %.2f (2 expected)\n",
       ekf.options().adaptive.enabled ? "adaptive" : "fixed noise", c.reacquired,
-      c.adaptive_episodes, ekf.process_noise_scale(), c.MeanNis());
+      c.adaptive_episodes, c.sensor_episodes, ekf.process_noise_scale(),
+      ekf.measurement_noise_scale(), c.MeanNis());
   std::printf(
       "final pose (%.3f m, %.3f m, %.1f deg), sigma (%.3f m, %.3f m, %.2f deg); %d "
       "landmarks\n",
