@@ -164,9 +164,19 @@ TEST_F(DetectorTest, NoDepthMeansNoMeasurementNeverNaN) {
   std::vector<Detection> found = Detect(frame.colour, zero_depth, setup_, {}, &stats);
   ASSERT_EQ(found.size(), 1u);
   EXPECT_FALSE(found[0].measurement.has_value());
+  EXPECT_EQ(found[0].kind, "buckyball");  // its size fits a buckyball on the floor
   EXPECT_EQ(stats.without_depth, 1);
-  // Colour only (a photo): found, no range.
+  // Colour only, with the robot's camera: ranged on the ground plane, finite.
   found = Detect(frame.colour, cv::Mat(), setup_, {});
+  ASSERT_EQ(found.size(), 1u);
+  ASSERT_TRUE(found[0].measurement.has_value());
+  EXPECT_EQ(found[0].measurement->depth_pixels, 0);
+  EXPECT_TRUE(std::isfinite(found[0].measurement->range_m));
+  EXPECT_TRUE(found[0].measurement->covariance.allFinite());
+  // Colour only, no camera (a photo): found, no range.
+  DetectorSetup photo = setup_;
+  photo.camera.reset();
+  found = Detect(frame.colour, cv::Mat(), photo, {});
   ASSERT_EQ(found.size(), 1u);
   EXPECT_FALSE(found[0].measurement.has_value());
 }
