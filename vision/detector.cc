@@ -387,11 +387,17 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       // At its depth, how big should it be? Too small for every kind: noise (not eroded
       // away at a fixed size, which erased far balls in the thesis).
       double expected_radius_px = 0.0;
+      double largest_extent_px = 0.0;  // the widest any one kind of this colour can look here
       if (have_depth) {
         const double raw =
             MedianDepthMm(depth_mm(window), blob_mask, cv::Rect(cv::Point(), window.size()));
         if (raw > 0.0) {
           const double z = setup.camera->CorrectDepthM(raw);
+          for (const TargetKind& k : kinds) {
+            largest_extent_px = std::max(
+                largest_extent_px, focal * std::hypot(2.0 * k.radius_m, 2.0 * k.centre_height_m) /
+                                       (z + k.surface_to_centre_m));
+          }
           for (const TargetKind& k : kinds) {
             if (k.radius_m > 0.0)
               expected_radius_px =
@@ -428,7 +434,16 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       // (two balls overlapping by 45 % of a diameter still fill only 97.8 %).
       std::vector<cv::Point> hull;
       cv::convexHull(blob, hull);
-      const bool convex = blob_area >= options.single_object_solidity * cv::contourArea(hull);
+      // Kinds that are not round (rings, cubes, stars, blocks) have concave outlines of their
+      // own: with depth, when none of the colour's kinds is round, a blob no wider and no
+      // taller than one of them can look (its diagonal) is that one object, never cut.
+      const bool none_round =
+          std::none_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
+      const bool one_object = none_round && largest_extent_px > 0.0 &&
+                              box.width <= largest_extent_px + options.extent_margin_px &&
+                              box.height <= largest_extent_px + options.extent_margin_px;
+      const bool convex =
+          one_object || blob_area >= options.single_object_solidity * cv::contourArea(hull);
       SeparationResult separated;
       if (convex) {
         std::vector<cv::Point> shifted = blob;

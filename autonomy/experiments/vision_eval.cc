@@ -224,7 +224,7 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
     for (const auto& [id, o] : expected) groups[root(id)].push_back(id);
 
     for (VisionMethodScore& s : scores) {
-      vision::DetectOptions detect;
+      vision::DetectOptions detect = options.detect;
       detect.method = s.method;
       detect.separation = s.separation;
       detect.seed = options.seed;

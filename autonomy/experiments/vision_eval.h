@@ -33,7 +33,8 @@ struct VisionEvalOptions {
   // The field gate's pose: the true pose plus Gaussian error of this sigma (m) in x and y,
   // which the gate is also told.
   double pose_sigma_m = 0.05;
-  std::string picture_dir;  // when set: annotated views of the worst frames go here
+  vision::DetectOptions detect;  // every method's options but its method and separation
+  std::string picture_dir;       // when set: annotated views of the worst frames go here
   int picture_frames = 12;
   std::string picture_method = "kmeans+defects";  // whose detections the pictures show
 };
