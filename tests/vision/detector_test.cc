@@ -256,9 +256,15 @@ TEST_P(SingleObjectTest, IsNeverCut) {
   EXPECT_GE(views, 16);
 }
 
+// Printed by type in test names (the default would print the struct's bytes, pointers too).
+void PrintTo(const SingleObjectCase& c, std::ostream* out) { *out << c.season << "/" << c.type; }
+
 INSTANTIATE_TEST_SUITE_P(Shapes, SingleObjectTest,
                          ::testing::Values(SingleObjectCase{"starstruck", "star", -1.6, 1.5},
-                                           SingleObjectCase{"high_stakes", "ring", -1.1, 2.0}));
+                                           SingleObjectCase{"high_stakes", "ring", -1.1, 2.0}),
+                         [](const ::testing::TestParamInfo<SingleObjectCase>& info) {
+                           return std::string(info.param.type);
+                         });
 
 TEST(ColourClassesTest, RedHueWrapsAroundZero) {
   const ColourClass red = MakeColourClass("red", field::Rgb{220, 20, 40});  // hue ~354 deg
