@@ -22,6 +22,7 @@ SlamO::SlamO(const field::SeasonConfig& season, const field::CameraConfig& camer
       options_(options),
       landmark_detector_(vision::LandmarkDetectorSetup(season_, &camera_)),
       object_detector_(vision::ObjectDetectorSetup(season_, &camera_)),
+      field_bounds_(vision::FieldBoundsOf(season_)),
       ekf_(prior.pose, prior.covariance, options.ekf),
       selector_(FrameSelectionOptions{}),
       object_map_(season_),
@@ -136,15 +137,22 @@ LandmarkFrame SlamO::UpdateLandmarks(const platform::RgbdFrame& frame) {
 
 void SlamO::TrackObjects(const platform::RgbdFrame& frame, double t_s) {
   std::vector<ObjectObservation> seen;
-  for (const vision::Detection& d :
-       vision::Detect(frame.colour, frame.depth_mm, object_detector_, {})) {
+  const Eigen::Vector3d pose = ekf_.pose();
+  std::vector<vision::Detection> detections =
+      vision::Detect(frame.colour, frame.depth_mm, object_detector_, {});
+  if (options_.field_gate) {
+    vision::FieldGateOptions gate;
+    gate.pose_sigma_m = std::sqrt(ekf_.pose_covariance().topLeftCorner<2, 2>().trace());
+    detections = vision::RejectOffField(detections, *object_detector_.camera, pose, field_bounds_,
+                                        gate, {}, &rejected_by_geometry_);
+  }
+  for (const vision::Detection& d : detections) {
     if (!d.measurement) continue;
     seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
                     d.measurement->covariance});
   }
   // Placed through the best pose estimate (and its covariance); objects in view and range but
   // not seen lose confidence.
-  const Eigen::Vector3d pose = ekf_.pose();
   const double half_fov = std::atan(camera_.width_px / 2.0 / camera_.fx) - options_.fov_margin_rad;
   tracker_.Update(pose, ekf_.pose_covariance(), seen, t_s, [&](const Eigen::Vector2d& p) {
     const Eigen::Vector2d z = EkfSlam::Observe(pose, p);

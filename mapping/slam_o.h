@@ -28,6 +28,7 @@
 #include "platform/drive_base.h"
 #include "platform/rgbd.h"
 #include "vision/detector.h"
+#include "vision/field_gate.h"
 
 namespace slamo::mapping {
 
@@ -48,6 +49,9 @@ struct SlamOOptions {
   // Once per stop, when markers are in view and none pairs: widen the pose belief and pair
   // again (the encoders cannot tell when the wheels spun against something that did not move).
   bool relocalise = false;
+  // Drop object detections the field's geometry rules out (outside the perimeter, above
+  // where objects can be), seen from the pose estimate with its uncertainty.
+  bool field_gate = true;
   // Objects are tracked, and expected to be seen, within this range and the camera's field of
   // view less fov_margin_rad.
   double object_min_range_m = 0.8;
@@ -132,6 +136,7 @@ class SlamO {
   int frames() const { return frames_; }
   int gated_frames() const { return gated_frames_; }
   int relocalisations() const { return relocalisations_; }
+  int rejected_by_geometry() const { return rejected_by_geometry_; }
 
  private:
   std::vector<RangeBearing> MarkerMeasurements(const platform::RgbdFrame& frame) const;
@@ -143,6 +148,7 @@ class SlamO {
   SlamOOptions options_;
   vision::DetectorSetup landmark_detector_;
   vision::DetectorSetup object_detector_;
+  vision::FieldBounds field_bounds_;
   std::vector<int> marker_id_;  // per season landmark: its id in the filter, -1: by position
   EkfSlam ekf_;
   FrameSelector selector_;
@@ -154,6 +160,7 @@ class SlamO {
   int frames_ = 0;
   int gated_frames_ = 0;
   int relocalisations_ = 0;
+  int rejected_by_geometry_ = 0;
 };
 
 }  // namespace slamo::mapping

@@ -8,6 +8,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/field_gate.h"
+
 namespace slamo::vision {
 namespace {
 
@@ -111,6 +113,24 @@ std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlie
   }
   *inlier_fraction = points.empty() ? 0.0 : static_cast<double>(inliers.size()) / points.size();
   return fit;
+}
+
+// An object resting on the floor seen without depth: each kind has a range on the ground plane
+// (the plane of its centre); the kind whose apparent size fits best at its own range, within
+// the size tolerance, sets the detection's kind and measurement. False when none fits.
+bool FitOnFloor(const CameraModel& camera, const std::vector<TargetKind>& kinds,
+                const DetectOptions& options, Detection* d) {
+  double best_ratio = options.size_tolerance;
+  for (const TargetKind& k : kinds) {
+    if (k.radius_m <= 0.0 || k.centre_height_m <= 0.0) continue;
+    std::optional<Measurement> m = GroundPlaneMeasurement(camera, d->centre_px, d->radius_px,
+                                                          k.centre_height_m, options.measurement);
+    if (!m) continue;
+    const double expected = camera.config().fx * k.radius_m / m->depth_m;
+    const double ratio = std::max(d->radius_px / expected, expected / d->radius_px);
+    if (ratio < best_ratio) best_ratio = ratio, d->kind = k.name, d->measurement = m;
+  }
+  return d->measurement.has_value();
 }
 
 std::vector<TargetKind> KindsOf(const DetectorSetup& setup, const std::string& colour) {
@@ -245,6 +265,7 @@ DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
       // blocks seen from a low camera are flat shapes.
       k.min_circularity = round ? 0.6 : 0.3;
       k.round = round;
+      k.centre_height_m = type.height_m / 2.0;
       setup.kinds.push_back(k);
     }
   }
@@ -366,11 +387,17 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       // At its depth, how big should it be? Too small for every kind: noise (not eroded
       // away at a fixed size, which erased far balls in the thesis).
       double expected_radius_px = 0.0;
+      double largest_extent_px = 0.0;  // the widest any one kind of this colour can look here
       if (have_depth) {
         const double raw =
             MedianDepthMm(depth_mm(window), blob_mask, cv::Rect(cv::Point(), window.size()));
         if (raw > 0.0) {
           const double z = setup.camera->CorrectDepthM(raw);
+          for (const TargetKind& k : kinds) {
+            largest_extent_px = std::max(
+                largest_extent_px, focal * std::hypot(2.0 * k.radius_m, 2.0 * k.centre_height_m) /
+                                       (z + k.surface_to_centre_m));
+          }
           for (const TargetKind& k : kinds) {
             if (k.radius_m > 0.0)
               expected_radius_px =
@@ -407,7 +434,16 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       // (two balls overlapping by 45 % of a diameter still fill only 97.8 %).
       std::vector<cv::Point> hull;
       cv::convexHull(blob, hull);
-      const bool convex = blob_area >= options.single_object_solidity * cv::contourArea(hull);
+      // Kinds that are not round (rings, cubes, stars, blocks) have concave outlines of their
+      // own: with depth, when none of the colour's kinds is round, a blob no wider and no
+      // taller than one of them can look (its diagonal) is that one object, never cut.
+      const bool none_round =
+          std::none_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
+      const bool one_object = none_round && largest_extent_px > 0.0 &&
+                              box.width <= largest_extent_px + options.extent_margin_px &&
+                              box.height <= largest_extent_px + options.extent_margin_px;
+      const bool convex =
+          one_object || blob_area >= options.single_object_solidity * cv::contourArea(hull);
       SeparationResult separated;
       if (convex) {
         std::vector<cv::Point> shifted = blob;
@@ -500,6 +536,16 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           const std::optional<BlobSurface> surface =
               MeasureBlobSurface(depth_roi, piece_mask, *setup.camera, options.measurement);
           if (!surface) {
+            // No reading on it (too near or far, black, glare): kept when it has the size of
+            // a kind resting on the floor at the ground-plane range, typed but not ranged.
+            Detection on_floor = d;
+            if (!FitOnFloor(*setup.camera, kinds, options, &on_floor) && on_floor.kind.empty() &&
+                std::any_of(kinds.begin(), kinds.end(),
+                            [](const TargetKind& k) { return k.centre_height_m > 0.0; })) {
+              ++st.rejected_size;
+              continue;
+            }
+            d.kind = on_floor.kind;
             ++st.without_depth;
           } else {
             const TargetKind* best = nullptr;
@@ -519,6 +565,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             d.measurement = MeasureFromSurface(*surface, d.centre_px, best->surface_to_centre_m,
                                                d.radius_px, *setup.camera, options.measurement);
           }
+        } else if (setup.camera && depth_mm.empty()) {
+          if (!FitOnFloor(*setup.camera, kinds, options, &d)) ++st.without_depth;
         }
         out.push_back(std::move(d));
       }

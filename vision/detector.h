@@ -34,6 +34,9 @@ struct DetectOptions {
   size_t separation_max_pixels = 6000;    // larger blob windows are separated scaled down
   double min_expected_area_ratio = 0.15;  // with depth: blobs below this x the expected area go
   double size_tolerance = 1.8;  // with depth: apparent radius within [1/x, x] of an object's
+  // With depth, a blob of a colour with no round kind that is at most one object's apparent
+  // diagonal wide and tall (plus this, px: the outline's pixel quantisation) is not separated.
+  double extent_margin_px = 2.0;
   // Round kinds: a circle fitted to the blob's outline (not the image border or a cut) must
   // fit within this x its radius (rms) and cover at least this much of the circle.
   double max_arc_rms_ratio = 0.1;
@@ -56,6 +59,7 @@ struct TargetKind {
   std::string colour;                // a class name
   double radius_m = 0.0;             // apparent radius (half the size)
   double surface_to_centre_m = 0.0;  // from the visible surface to the centre
+  double centre_height_m = 0.0;      // the centre above the floor, resting on it (0: unknown)
   double min_circularity = 0.6;      // 4 pi A / P^2 of an unoccluded view (flat kinds)
   bool round = true;                 // looks like a disc from anywhere: judged by a circle fit
 };
@@ -78,7 +82,9 @@ DetectorSetup PhotoDetectorSetup(std::vector<ColourClass> colours);
 
 struct Detection {
   std::string colour;
-  std::string kind;  // the best-fitting TargetKind by size with depth; "" without depth
+  // The best-fitting TargetKind by size at the measured depth or, without a depth image, at
+  // the ground-plane range of an object resting on the floor; "" when none fits or no range.
+  std::string kind;
   cv::Point2d centre_px;
   double radius_px = 0.0;
   cv::Rect box;
@@ -96,9 +102,12 @@ struct DetectStats {
   int rejected_small = 0;
   int rejected_shape = 0;
   int rejected_size = 0;
-  int without_depth = 0;  // kept, but no range: no valid depth on them
+  int without_depth = 0;  // kept, but no range: no valid depth on them (or, without a depth
+                          // image, no kind resting on the floor fits their size)
 };
 
+// Without a depth image but with a camera, each detection's range comes from the ground plane
+// (vision/field_gate.h) for the kind whose apparent size fits best there.
 // Throws std::invalid_argument for unusable input: an empty or non-BGR colour image, a depth
 // image that is not CV_16UC1 or not the colour image's size.
 std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,

@@ -1,5 +1,6 @@
 // `slamo detect`: colour detection on one image (a rendered frame or an ordinary photo),
-// with range and bearing when a registered depth image is given.
+// with range and bearing when a registered depth image is given; without one, objects resting
+// on the floor are typed and ranged on the ground plane through the robot's camera mount.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -95,6 +96,7 @@ int Run(const DetectArgs& args) {
         j["y_m"] = m.position_robot_m.y();
         j["z_m"] = m.position_robot_m.z();
         j["covariance"] = {m.covariance(0, 0), m.covariance(0, 1), m.covariance(1, 1)};
+        j["ground_plane"] = m.depth_pixels == 0;
       }
       out.push_back(j);
     }
@@ -106,9 +108,9 @@ int Run(const DetectArgs& args) {
                   d.centre_px.y, d.radius_px, d.area_px, d.score, d.split ? "  split" : "");
       if (d.measurement) {
         const vision::Measurement& m = *d.measurement;
-        std::printf("  range %.3f m  bearing %6.1f deg  robot (%.3f, %.3f, %.3f) m", m.range_m,
+        std::printf("  range %.3f m  bearing %6.1f deg  robot (%.3f, %.3f, %.3f) m%s", m.range_m,
                     m.bearing_rad * 180.0 / M_PI, m.position_robot_m.x(), m.position_robot_m.y(),
-                    m.position_robot_m.z());
+                    m.position_robot_m.z(), m.depth_pixels == 0 ? "  (ground plane)" : "");
       } else if (!depth.empty()) {
         std::printf("  no valid depth");
       }

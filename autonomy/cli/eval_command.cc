@@ -20,6 +20,10 @@ struct EvalArgs {
   uint64_t seed = 1;
   std::string pictures;
   std::string picture_method = "kmeans+defects";
+  bool arena = false;
+  bool no_depth = false;
+  double max_range_m = 3.0;
+  double pose_sigma_m = 0.05;
 };
 
 int RunVision(const EvalArgs& args) {
@@ -30,6 +34,10 @@ int RunVision(const EvalArgs& args) {
   options.seed = args.seed;
   options.picture_dir = args.pictures;
   options.picture_method = args.picture_method;
+  options.arena = args.arena;
+  options.depth = !args.no_depth;
+  options.max_range_m = args.max_range_m;
+  options.pose_sigma_m = args.pose_sigma_m;
   if (!args.pictures.empty()) std::filesystem::create_directories(args.pictures);
   const auto progress = [](int done, int total) {
     if (done % 10 == 0 || done == total) std::fprintf(stderr, "\rframe %d/%d", done, total);
@@ -37,11 +45,15 @@ int RunVision(const EvalArgs& args) {
   };
   const std::vector<VisionMethodScore> scores = EvaluateVision(season, robot, options, progress);
   std::printf(
-      "vision on %s: %d rendered views, seed %llu (objects with >= %d visible pixels are "
-      "expected)\n",
-      season.season.c_str(), args.frames, static_cast<unsigned long long>(args.seed),
-      options.min_visible_px);
+      "vision on %s, %s%s: %d rendered views, seed %llu (objects within %.1f m with >= %d "
+      "visible pixels are expected; field gate pose sigma %.2f m)\n",
+      season.season.c_str(), args.arena ? "arena" : "clean field",
+      args.no_depth ? ", no depth" : "", args.frames, static_cast<unsigned long long>(args.seed),
+      options.max_range_m, options.min_visible_px, options.pose_sigma_m);
   std::fputs(FormatVisionTable(scores).c_str(), stdout);
+  for (const VisionMethodScore& s : scores) {
+    if (s.name == args.picture_method) std::fputs(FormatTypeTable(s).c_str(), stdout);
+  }
   return 0;
 }
 
@@ -56,15 +68,29 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   CLI::App* vision = eval->add_subcommand(
       "vision",
       "Detection and separation methods on rendered views: precision, recall, errors.   "
-      "e.g. slamo eval vision --season toss_up --frames 100 --seed 1");
+      "e.g. slamo eval vision --season over_under --arena --frames 100 --seed 1");
   AddSeasonRobotOptions(vision, &args->season, &args->robot);
   vision->add_option("--frames", args->frames, "rendered views")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   vision->add_option("--seed", args->seed, "random seed")->capture_default_str();
+  vision->add_flag("--arena", args->arena,
+                   "render the arena: crowd, posters and lights beyond the perimeter, opponent "
+                   "robots on the field");
+  vision->add_flag("--no-depth", args->no_depth,
+                   "detect without the depth image (ranges and types from the ground plane)");
+  vision->add_option("--max-range", args->max_range_m, "objects within this range are expected (m)")
+      ->capture_default_str();
+  vision
+      ->add_option("--pose-sigma", args->pose_sigma_m,
+                   "error of the pose the field gate is given, 1 sigma in x and y (m)")
+      ->capture_default_str();
   vision->add_option("--pictures", args->pictures,
-                     "write annotated views of the first 12 frames (detections, misses) here");
-  vision->add_option("--picture-method", args->picture_method, "method the pictures show")
+                     "write annotated views of the 12 worst frames (detections, misses, false "
+                     "and off-field detections) here");
+  vision
+      ->add_option("--picture-method", args->picture_method,
+                   "method the pictures and the per-type table show")
       ->capture_default_str();
   vision->callback([action, args] { *action = [args] { return RunVision(*args); }; });
 }

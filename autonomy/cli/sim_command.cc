@@ -38,6 +38,7 @@ struct SimArgs {
   std::string out = "sim_render";
   bool baseline = false;
   bool no_noise = false;
+  bool arena = false;
   std::string script = "forward 0.3; turn 90; forward 0.6";
 };
 
@@ -54,6 +55,7 @@ int Render(const SimArgs& args) {
   platform::RenderOptions options;
   options.colour_depth_baseline = args.baseline;
   if (args.no_noise) options.depth_noise = options.colour_noise = false;
+  options.arena = args.arena;
   platform::SimRenderer renderer(season, robot.camera, options, args.seed);
   platform::FrameTruth truth;
   const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, &truth);
@@ -175,6 +177,9 @@ void RegisterSimCommand(CLI::App& app, CommandAction* action) {
   render->add_flag("--baseline", args->baseline,
                    "render colour from the colour camera's own position");
   render->add_flag("--no-noise", args->no_noise, "no depth or colour noise");
+  render->add_flag("--arena", args->arena,
+                   "an arena beyond the perimeter (crowd, posters, lights) and opponents with "
+                   "bumpers in their alliance colour");
   render->callback([action, args] { *action = [args] { return Render(*args); }; });
 
   CLI::App* drive = sim->add_subcommand(

@@ -12,6 +12,7 @@
 #include "platform/field_geometry.h"
 #include "platform/sim/sim_renderer.h"
 #include "platform/sim/sim_world.h"
+#include "vision/field_gate.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -37,15 +38,19 @@ Pose2D RandomView(const field::SeasonConfig& season, const field::RobotConfig& r
   return Pose2D{-1.5, 0.0, 0.0};
 }
 
-// Moves a random floor ball against another of the same type and colour, so touching groups
-// appear in view as they do on a real field.
+// Moves a random object resting on the floor against another of the same type and colour,
+// so touching groups appear in view as they do on a real field.
 void MakeTouchingPair(platform::SimWorld* world, std::mt19937_64* rng) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<SimObject>& objects = world->objects;
+  const auto on_floor = [](const SimObject& o) {
+    return o.center_m.z() <= o.type->height_m / 2.0 + 1e-3;
+  };
   for (int attempt = 0; attempt < 50; ++attempt) {
     SimObject& a = objects[static_cast<size_t>(unit(*rng) * objects.size())];
     SimObject& b = objects[static_cast<size_t>(unit(*rng) * objects.size())];
-    if (&a == &b || a.type != b.type || a.colour != b.colour) continue;
+    if (&a == &b || a.type != b.type || a.colour != b.colour || !on_floor(a) || !on_floor(b))
+      continue;
     const double angle = 2.0 * M_PI * unit(*rng);
     const double d = a.type->size_m * 1.001;
     b.center_m.x() = a.center_m.x() + d * std::cos(angle);
@@ -54,13 +59,83 @@ void MakeTouchingPair(platform::SimWorld* world, std::mt19937_64* rng) {
   }
 }
 
+// Arena: opponent robots (alternately red and blue) on free floor, most in front of the
+// camera 1-3 m away, none on an object or on the robot.
+void AddArenaOpponents(const field::SeasonConfig& season, const Pose2D& robot, int count,
+                       platform::SimWorld* world, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  constexpr double kSize = 0.457;  // an 18 in robot
+  for (int k = 0; k < count; ++k) {
+    for (int attempt = 0; attempt < 200; ++attempt) {
+      const double bearing = robot.theta_rad + (unit(*rng) - 0.5) * (attempt < 100 ? 1.2 : 6.3);
+      const double range = 1.0 + 2.0 * unit(*rng);
+      const Pose2D pose{robot.x_m + range * std::cos(bearing),
+                        robot.y_m + range * std::sin(bearing), 2.0 * M_PI * unit(*rng)};
+      if (!platform::FootprintIsFree(season, pose, kSize + 0.05, kSize + 0.05)) continue;
+      const auto clear = [&](double x, double y, double r) {
+        return std::hypot(x - pose.x_m, y - pose.y_m) > kSize / std::sqrt(2.0) + r;
+      };
+      bool free = clear(robot.x_m, robot.y_m, 0.35);
+      for (const SimObject& o : world->objects)
+        free = free && clear(o.center_m.x(), o.center_m.y(), o.type->size_m / 2.0);
+      for (const platform::SimOpponent& o : world->opponents)
+        free = free && clear(o.pose.x_m, o.pose.y_m, kSize / std::sqrt(2.0));
+      if (!free) continue;
+      platform::SimOpponent opponent;
+      opponent.config.alliance = k % 2 ? field::Alliance::kBlue : field::Alliance::kRed;
+      opponent.config.size_m = {kSize, kSize};
+      opponent.pose = pose;
+      world->opponents.push_back(opponent);
+      break;
+    }
+  }
+}
+
 int Band(double range_m) { return std::min(3, static_cast<int>(range_m)); }
+
+// The object id under most of a detection's pixels in the truth image, or 0 (background,
+// landmarks, robots, or no majority).
+int TruthIdUnder(const vision::Detection& d, const cv::Mat& ids) {
+  const cv::Rect box = d.box & cv::Rect(0, 0, ids.cols, ids.rows);
+  cv::Mat mask(box.size(), CV_8UC1, cv::Scalar(0));
+  cv::drawContours(mask, std::vector<std::vector<cv::Point>>{d.contour}, 0, cv::Scalar(255),
+                   cv::FILLED, cv::LINE_8, cv::noArray(), 0, -box.tl());
+  std::map<int, int> votes;
+  for (int v = 0; v < box.height; ++v) {
+    for (int u = 0; u < box.width; ++u) {
+      if (mask.at<uint8_t>(v, u)) ++votes[ids.at<uint16_t>(v + box.y, u + box.x)];
+    }
+  }
+  int best_id = 0, best_votes = 0, total = 0;
+  for (const auto& [id, n] : votes) {
+    total += n;
+    if (id > 0 && id < platform::kLandmarkIdBase && n > best_votes) best_id = id, best_votes = n;
+  }
+  return best_votes * 2 >= total ? best_id : 0;
+}
+
+void Label(cv::Mat* image, const std::string& text, cv::Point at, const cv::Scalar& colour) {
+  at.y = std::max(12, at.y);
+  cv::putText(*image, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+  cv::putText(*image, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.4, colour, 1, cv::LINE_AA);
+}
+
+struct Picture {
+  int badness = 0;  // false detections kept plus expected objects missed
+  int frame = 0;
+  cv::Mat image;
+};
 
 }  // namespace
 
 double VisionMethodScore::Precision() const {
   const int all = true_positives + false_positives;
   return all ? static_cast<double>(true_positives) / all : 0.0;
+}
+
+double VisionMethodScore::RawPrecision() const {
+  const int all = raw_true_positives + raw_false_positives;
+  return all ? static_cast<double>(raw_true_positives) / all : 0.0;
 }
 
 double VisionMethodScore::Recall() const {
@@ -88,31 +163,45 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
     }
   }
   const vision::DetectorSetup setup = vision::ObjectDetectorSetup(season, &robot.camera);
+  const vision::FieldBounds bounds = vision::FieldBoundsOf(season);
+  vision::FieldGateOptions gate;
+  gate.pose_sigma_m = options.pose_sigma_m;
   std::mt19937_64 rng(options.seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<Picture> worst;
 
   for (int frame_index = 0; frame_index < options.frames; ++frame_index) {
     // A scene and a view of it.
     platform::SimWorld world = platform::CreateWorld(season, options.seed * 1000003 + frame_index);
     if (unit(rng) < options.touching_fraction) MakeTouchingPair(&world, &rng);
     const Pose2D pose = RandomView(season, robot, world, &rng);
-    platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{},
-                                   options.seed + frame_index);
+    platform::RenderOptions render;
+    render.arena = options.arena;
+    if (options.arena) AddArenaOpponents(season, pose, options.arena_opponents, &world, &rng);
+    platform::SimRenderer renderer(season, robot.camera, render, options.seed + frame_index);
     platform::FrameTruth truth;
     const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, &truth);
+    // The gate sees the pose as an estimate would give it.
+    const Eigen::Vector3d gate_pose(pose.x_m + options.pose_sigma_m * normal(rng),
+                                    pose.y_m + options.pose_sigma_m * normal(rng), pose.theta_rad);
+    std::map<int, const SimObject*> object_of;
+    for (const SimObject& o : world.objects) object_of[o.id] = &o;
 
-    // What should be found: objects with enough visible pixels and most of their disc in
-    // view; the rest with enough pixels are "hidden" (scored apart).
+    // What should be found: objects in range with enough visible pixels and most of their
+    // disc in view; the rest in range with enough pixels are "hidden" (scored apart).
     std::map<int, const platform::ObjectTruth*> expected, hidden;
     for (const platform::ObjectTruth& o : truth.objects) {
       if (o.pixels < options.min_visible_px) continue;
+      const double range = std::hypot(o.position_m.x() - pose.x_m, o.position_m.y() - pose.y_m);
+      if (range > options.max_range_m) continue;
       const double radius_px =
           robot.camera.fx * season.FindObjectType(o.type)->size_m / 2.0 / o.position_cam_m.z();
       const bool mostly_visible =
           o.pixels >= options.min_visible_fraction * M_PI * radius_px * radius_px;
       (mostly_visible ? expected : hidden)[o.id] = &o;
     }
-    // Touching groups: same colour, masks within 2 px of each other in the image.
+    // Touching groups (stacks too): same colour, masks within 2 px of each other.
     std::map<int, cv::Mat> dilated;
     for (const auto& [id, o] : expected) {
       cv::dilate(truth.ids == id, dilated[id], cv::Mat(), cv::Point(-1, -1), 2);
@@ -135,51 +224,44 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
     for (const auto& [id, o] : expected) groups[root(id)].push_back(id);
 
     for (VisionMethodScore& s : scores) {
-      const bool picture = !options.picture_dir.empty() && frame_index < options.picture_frames &&
-                           s.name == options.picture_method;
-      std::vector<int> missed_ids;
-      vision::DetectOptions detect;
+      vision::DetectOptions detect = options.detect;
       detect.method = s.method;
       detect.separation = s.separation;
       detect.seed = options.seed;
       const std::vector<vision::Detection> found =
-          vision::Detect(frame.colour, frame.depth_mm, setup, detect);
+          vision::Detect(frame.colour, options.depth ? frame.depth_mm : cv::Mat(), setup, detect);
       std::set<int> matched;
+      std::vector<const vision::Detection*> kept, rejected, false_kept;
       for (const vision::Detection& d : found) {
-        // The truth object under most of the detection.
-        cv::Mat mask(frame.colour.size(), CV_8UC1, cv::Scalar(0));
-        cv::drawContours(mask, std::vector<std::vector<cv::Point>>{d.contour}, 0, cv::Scalar(255),
-                         cv::FILLED);
-        std::map<int, int> votes;
-        for (int v = d.box.y; v < d.box.y + d.box.height; ++v) {
-          for (int u = d.box.x; u < d.box.x + d.box.width; ++u) {
-            if (mask.at<uint8_t>(v, u)) ++votes[truth.ids.at<uint16_t>(v, u)];
-          }
+        const int id = TruthIdUnder(d, truth.ids);
+        const SimObject* object = id ? object_of[id] : nullptr;
+        const bool hit = object && object->colour == d.colour && matched.count(id) == 0;
+        ++(hit ? s.raw_true_positives : s.raw_false_positives);
+        if (!vision::OnField(d, *setup.camera, gate_pose, bounds, gate, detect.measurement)) {
+          ++s.rejected_by_geometry;
+          s.rejected_objects += hit;
+          rejected.push_back(&d);
+          continue;
         }
-        int best_id = 0, best_votes = 0, total = 0;
-        for (const auto& [id, n] : votes) {
-          total += n;
-          if (id > 0 && id < platform::kLandmarkIdBase && n > best_votes)
-            best_id = id, best_votes = n;
+        kept.push_back(&d);
+        if (!d.kind.empty()) {
+          TypeScore& t = s.types[d.kind];
+          ++t.detected;
+          t.detected_right += hit && object->type->name == d.kind;
         }
-        const SimObject* object = nullptr;
-        for (const SimObject& o : world.objects) {
-          if (o.id == best_id) object = &o;
-        }
-        const bool hit = object && best_votes * 2 >= total && object->colour == d.colour &&
-                         matched.count(best_id) == 0;
         if (!hit) {
           ++s.false_positives;
+          false_kept.push_back(&d);
           continue;
         }
         ++s.true_positives;
-        matched.insert(best_id);
-        if (expected.count(best_id) == 0) continue;  // hidden: right, but not expected
+        matched.insert(id);
+        if (expected.count(id) == 0) continue;  // hidden or far: right, but not expected
+        TypeScore& t = s.types[object->type->name];
+        t.typed += !d.kind.empty();
+        t.typed_right += d.kind == object->type->name;
         // Centre and position errors.
-        const auto it =
-            std::find_if(truth.objects.begin(), truth.objects.end(),
-                         [&](const platform::ObjectTruth& o) { return o.id == best_id; });
-        const Eigen::Vector3d& c = it->position_cam_m;
+        const Eigen::Vector3d& c = expected[id]->position_cam_m;
         const cv::Point2d projected(robot.camera.fx * c.x() / c.z() + robot.camera.cx,
                                     robot.camera.fy * c.y() / c.z() + robot.camera.cy);
         s.centre_error_px_sum += cv::norm(projected - d.centre_px);
@@ -197,18 +279,19 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
           ++band.second;
         }
       }
+      std::vector<int> missed_ids;
       for (const auto& [id, o] : expected) {
-        if (matched.count(id) == 0) missed_ids.push_back(id);
-        const SimObject* object = nullptr;
-        for (const SimObject& w : world.objects) {
-          if (w.id == id) object = &w;
-        }
+        const SimObject* object = object_of[id];
         const bool semi = object->type->material == field::Material::kSemiTransparent;
         const bool got = matched.count(id) > 0;
+        if (!got) missed_ids.push_back(id);
         ++s.expected;
         s.found += got;
         (semi ? s.expected_semi : s.expected_solid)++;
         (semi ? s.found_semi : s.found_solid) += got;
+        TypeScore& t = s.types[object->type->name];
+        ++t.expected;
+        t.found += got;
       }
       for (const auto& [id, o] : hidden) {
         ++s.expected_hidden;
@@ -220,30 +303,52 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
         s.groups_counted += std::all_of(members.begin(), members.end(),
                                         [&](int id) { return matched.count(id) > 0; });
       }
-      if (picture) {
-        // Detections (green; yellow when split) and the expected objects missed (red boxes).
-        cv::Mat out = vision::DrawDetections(frame.colour, found);
-        for (int id : missed_ids) {
-          cv::rectangle(out, expected[id]->box, cv::Scalar(0, 0, 255), 2);
-          cv::putText(out, "missed " + expected[id]->colour + " " + expected[id]->type,
-                      expected[id]->box.tl() + cv::Point(0, -3), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-                      cv::Scalar(0, 0, 255), 1, cv::LINE_AA);
-        }
-        char name[64];
-        std::snprintf(name, sizeof(name), "/frame_%03d.png", frame_index);
-        cv::imwrite(options.picture_dir + name, out);
+      const int badness = static_cast<int>(false_kept.size() + missed_ids.size());
+      if (options.picture_dir.empty() || s.name != options.picture_method || badness == 0 ||
+          (static_cast<int>(worst.size()) >= options.picture_frames &&
+           badness <= worst.back().badness)) {
+        continue;
       }
+      // The frame as the method saw it: detections kept (green; yellow when split), false
+      // ones among them (magenta box), those the field gate dropped (grey), and the
+      // expected objects missed (red boxes).
+      std::vector<vision::Detection> shown;
+      for (const vision::Detection* d : kept) shown.push_back(*d);
+      cv::Mat out = vision::DrawDetections(frame.colour, shown);
+      for (const vision::Detection* d : rejected) {
+        cv::drawContours(out, std::vector<std::vector<cv::Point>>{d->contour}, 0,
+                         cv::Scalar(150, 150, 150), 2, cv::LINE_AA);
+        Label(&out, "off field", d->box.tl() + cv::Point(0, -3), cv::Scalar(190, 190, 190));
+      }
+      for (const vision::Detection* d : false_kept) {
+        cv::rectangle(out, d->box, cv::Scalar(255, 0, 255), 1);
+      }
+      for (int id : missed_ids) {
+        cv::rectangle(out, expected[id]->box, cv::Scalar(0, 0, 255), 2);
+        Label(&out, "missed " + expected[id]->colour + " " + expected[id]->type,
+              expected[id]->box.tl() + cv::Point(0, -3), cv::Scalar(0, 0, 255));
+      }
+      worst.push_back({badness, frame_index, out});
+      std::stable_sort(worst.begin(), worst.end(),
+                       [](const Picture& a, const Picture& b) { return a.badness > b.badness; });
+      if (static_cast<int>(worst.size()) > options.picture_frames) worst.pop_back();
     }
     if (progress) progress(frame_index + 1, options.frames);
+  }
+  for (size_t k = 0; k < worst.size(); ++k) {
+    char name[96];
+    std::snprintf(name, sizeof(name), "/worst_%02zu_frame_%03d.png", k + 1, worst[k].frame);
+    cv::imwrite(options.picture_dir + name, worst[k].image);
   }
   return scores;
 }
 
 std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores) {
   std::string out;
-  char line[256];
-  std::snprintf(line, sizeof(line), "%-18s %9s %6s %6s %6s %7s %7s %9s %9s  %s\n", "method",
-                "precision", "recall", "solid", "semi", "hidden", "groups", "count_ok", "centre_px",
+  char line[320];
+  std::snprintf(line, sizeof(line), "%-19s %9s %8s %8s %6s %6s %6s %6s %7s %7s %8s %9s  %s\n",
+                "method", "precision", "no_gate", "rejected", "wrong", "recall", "solid", "semi",
+                "hidden", "groups", "count_ok", "centre_px",
                 "position error m: <1m  1-2m  2-3m  3m+");
   out += line;
   for (const VisionMethodScore& s : scores) {
@@ -259,11 +364,30 @@ std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores) {
       }
       bands += cell;
     }
-    std::snprintf(line, sizeof(line), "%-18s %9.3f %6.3f %6.3f %6.3f %7.3f %7d %9.3f %9.2f  %s\n",
-                  s.name.c_str(), s.Precision(), s.Recall(), ratio(s.found_solid, s.expected_solid),
+    std::snprintf(line, sizeof(line),
+                  "%-19s %9.3f %8.3f %8d %6d %6.3f %6.3f %6.3f %7.3f %7d %8.3f %9.2f  %s\n",
+                  s.name.c_str(), s.Precision(), s.RawPrecision(), s.rejected_by_geometry,
+                  s.rejected_objects, s.Recall(), ratio(s.found_solid, s.expected_solid),
                   ratio(s.found_semi, s.expected_semi), ratio(s.found_hidden, s.expected_hidden),
                   s.groups, ratio(s.groups_counted, s.groups),
                   s.centre_errors ? s.centre_error_px_sum / s.centre_errors : 0.0, bands.c_str());
+    out += line;
+  }
+  return out;
+}
+
+std::string FormatTypeTable(const VisionMethodScore& s) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof(line), "%-19s %9s %9s %8s %8s %6s %8s %10s\n",
+                ("types, " + s.name).c_str(), "detected", "precision", "expected", "found",
+                "recall", "typed", "type_right");
+  out += line;
+  for (const auto& [name, t] : s.types) {
+    const auto ratio = [](int a, int b) { return b ? static_cast<double>(a) / b : 0.0; };
+    std::snprintf(line, sizeof(line), "%-19s %9d %9.3f %8d %8d %6.3f %8d %10.3f\n", name.c_str(),
+                  t.detected, ratio(t.detected_right, t.detected), t.expected, t.found,
+                  ratio(t.found, t.expected), t.typed, ratio(t.typed_right, t.typed));
     out += line;
   }
   return out;

@@ -1,8 +1,11 @@
-// Vision against the simulator's ground truth: renders random views of a season's field,
-// runs every detection method (threshold / K-Means) with every separation method (concave
-// defects / watershed / none), and scores them: precision, recall (solid and semi-transparent
-// objects apart), count accuracy on groups of touching objects, centre error in pixels and
-// position error in metres by distance band.
+// Vision against the simulator's ground truth: renders random views of a season's field
+// (clean, or in the arena: a crowd, posters and lights beyond the perimeter and opponent
+// robots on the field), runs every detection method (threshold / K-Means) with every
+// separation method (concave defects / watershed / none), drops the detections the field's
+// geometry rules out (vision/field_gate.h), and scores them: precision with and without that
+// gate, recall (solid and semi-transparent objects apart), count accuracy on groups of
+// touching objects (stacks included), centre error in pixels, position error in metres by
+// distance band, and per object type precision, recall and typing.
 #pragma once
 
 #include <cstdint>
@@ -20,21 +23,42 @@ namespace slamo::autonomy {
 struct VisionEvalOptions {
   int frames = 50;
   uint64_t seed = 1;
+  bool arena = false;       // render the arena (platform/sim/sim_arena.h)
+  int arena_opponents = 2;  // arena: robots placed on the field, one per alliance
+  bool depth = true;  // false: the detector gets no depth image (ranges from the ground plane)
+  double max_range_m = 3.0;           // objects further from the robot are not expected
   int min_visible_px = 40;            // truth objects with fewer visible pixels are not expected
   double min_visible_fraction = 0.5;  // ... nor those showing less of their disc than this
-  double touching_fraction = 0.5;     // share of frames where a ball is moved against another
-  std::string picture_dir;            // when set: annotated views of the first frames go here
+  double touching_fraction = 0.5;     // share of frames where an object is moved against another
+  // The field gate's pose: the true pose plus Gaussian error of this sigma (m) in x and y,
+  // which the gate is also told.
+  double pose_sigma_m = 0.05;
+  vision::DetectOptions detect;  // every method's options but its method and separation
+  std::string picture_dir;       // when set: annotated views of the worst frames go here
   int picture_frames = 12;
   std::string picture_method = "kmeans+defects";  // whose detections the pictures show
+};
+
+struct TypeScore {
+  int detected = 0;        // detections the detector typed as this type (after the gate)
+  int detected_right = 0;  // ... that are an object of this type
+  int expected = 0;        // expected objects of this type
+  int found = 0;           // ... matched by a detection
+  int typed = 0;           // ... matched by a detection typed (with a range)
+  int typed_right = 0;     // ... typed as this type
 };
 
 struct VisionMethodScore {
   std::string name;  // e.g. "kmeans+defects"
   vision::DetectMethod method = vision::DetectMethod::kThreshold;
   vision::SeparationMethod separation = vision::SeparationMethod::kConcaveDefects;
-  int true_positives = 0;
+  int true_positives = 0;  // after the field gate
   int false_positives = 0;
-  int expected = 0;  // visible truth objects (enough pixels, mostly unoccluded)
+  int raw_true_positives = 0;  // without the gate
+  int raw_false_positives = 0;
+  int rejected_by_geometry = 0;  // detections the gate dropped
+  int rejected_objects = 0;      // ... of which were objects (wrongly dropped)
+  int expected = 0;  // visible truth objects (enough pixels, mostly unoccluded, in range)
   int found = 0;     // of those, matched
   int expected_hidden = 0, found_hidden = 0;  // enough pixels but mostly hidden
   int expected_solid = 0, found_solid = 0;
@@ -45,8 +69,10 @@ struct VisionMethodScore {
   int centre_errors = 0;
   // Distance band (0: < 1 m, 1: 1-2 m, 2: 2-3 m, 3: >= 3 m) -> (sum of errors, count).
   std::map<int, std::pair<double, int>> position_error_m;
+  std::map<std::string, TypeScore> types;
 
   double Precision() const;
+  double RawPrecision() const;
   double Recall() const;
 };
 
@@ -58,5 +84,7 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
 
 // The scores as a table, one row per method.
 std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores);
+// One method's scores per object type.
+std::string FormatTypeTable(const VisionMethodScore& score);
 
 }  // namespace slamo::autonomy

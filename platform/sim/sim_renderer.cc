@@ -35,7 +35,7 @@ struct SimRenderer::Primitive {
   double opacity = 1.0;
   bool glossy = false;
   int id = 0;
-  Vector3d aabb_min, aabb_max;
+  Vector3d aabb_min = Vector3d::Zero(), aabb_max = Vector3d::Zero();
 };
 
 namespace {
@@ -309,6 +309,44 @@ Primitive ObjectPrimitive(const field::SeasonConfig& season, const SimObject& ob
   return p;
 }
 
+// An opponent in arena mode, from its footprint box `body`: a dark metal chassis, bumpers in
+// the alliance's colour all round its foot, and an alliance-coloured flag plate on top.
+void AddArenaRobot(const field::SeasonConfig& season, const Primitive& body, const char* alliance,
+                   std::vector<Primitive>* out) {
+  const Vector3d team =
+      season.colours.count(alliance) ? Albedo(season, alliance) : Vector3d(Vector3d::Constant(0.5));
+  Primitive chassis = body;
+  chassis.albedo = Vector3d(0.22, 0.22, 0.24);
+  chassis.glossy = true;
+  SetAabb(&chassis);
+  out->push_back(chassis);
+  constexpr double kBumper = 0.06;  // thickness (m)
+  for (int side = 0; side < 4; ++side) {
+    Primitive bumper = body;
+    const bool along_x = side < 2;
+    const double sign = side % 2 ? -1.0 : 1.0;
+    const double offset = (along_x ? body.half_y : body.half_x) + kBumper / 2.0;
+    const Vector3d local = along_x ? Vector3d(0, sign * offset, 0) : Vector3d(sign * offset, 0, 0);
+    bumper.center = body.center + Vector3d(body.cos_yaw * local.x() - body.sin_yaw * local.y(),
+                                           body.sin_yaw * local.x() + body.cos_yaw * local.y(), 0);
+    bumper.half_x = along_x ? body.half_x + kBumper : kBumper / 2.0;
+    bumper.half_y = along_x ? kBumper / 2.0 : body.half_y;
+    bumper.z0 = 0.02;
+    bumper.z1 = 0.14;
+    bumper.albedo = team;
+    SetAabb(&bumper);
+    out->push_back(bumper);
+  }
+  Primitive flag = body;
+  flag.half_x = 0.01;
+  flag.half_y = std::min(0.12, body.half_y);
+  flag.z0 = body.z1;
+  flag.z1 = body.z1 + 0.15;
+  flag.albedo = team;
+  SetAabb(&flag);
+  out->push_back(flag);
+}
+
 }  // namespace
 
 struct SimRenderer::Buffers {
@@ -334,6 +372,7 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
     : season_(season),
       camera_(camera),
       options_(options),
+      seed_(seed),
       rng_(seed),
       depth_buffers_(std::make_unique<Buffers>()),
       colour_buffers_(std::make_unique<Buffers>()) {
@@ -425,7 +464,7 @@ double SimRenderer::DepthSigmaM(double depth_m) const {
 }
 
 void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& world_from_camera,
-                             Buffers* out) const {
+                             const ArenaBackdrop* arena, Buffers* out) const {
   const int w = camera_.width_px;
   const int h = camera_.height_px;
   out->Reset(w, h);
@@ -542,6 +581,8 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
           out->colour[i] = wall_colour[wall];
           out->t[i] = t_wall;
           out->no_depth[i] = wall_black;
+        } else if (arena) {
+          ShadeArena(*arena, o, d, &out->colour[i], &out->t[i], &out->no_depth[i]);
         } else {
           // The venue: dim, no depth within the camera's range.
           const float g = 0.25f + 0.1f * std::max(0.0f, d.z() / d.norm());
@@ -569,6 +610,10 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     p.cos_yaw = std::cos(o.pose.theta_rad);
     p.sin_yaw = std::sin(o.pose.theta_rad);
     const char* alliance = field::ToString(o.config.alliance);
+    if (arena) {
+      AddArenaRobot(season_, p, alliance, &primitives);
+      continue;
+    }
     p.albedo = season_.colours.count(alliance) ? Vector3d(0.6 * Albedo(season_, alliance))
                                                : Vector3d(Vector3d::Constant(0.3));
     SetAabb(&p);
@@ -763,14 +808,20 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
   const int h = camera_.height_px;
   const Eigen::Isometry3d world_from_camera = CameraPose(robot);
   Buffers& depth_pass = *depth_buffers_;
-  RenderPass(world, world_from_camera, &depth_pass);
+  if (options_.arena) {
+    // A new hall for every frame, from the seed and the frame's index.
+    arena_ = MakeArenaBackdrop(season_, options_.arena_options,
+                               seed_ * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(frame_index_));
+  }
+  const ArenaBackdrop* arena = options_.arena ? &arena_ : nullptr;
+  RenderPass(world, world_from_camera, arena, &depth_pass);
   Buffers& colour_pass_storage = *colour_buffers_;
   const Buffers* colour_pass = &depth_pass;
   if (options_.colour_depth_baseline && camera_.colour_depth_baseline_m != 0.0) {
     Eigen::Isometry3d colour_pose = world_from_camera;
     colour_pose.translation() +=
         world_from_camera.linear() * Vector3d(camera_.colour_depth_baseline_m, 0, 0);
-    RenderPass(world, colour_pose, &colour_pass_storage);
+    RenderPass(world, colour_pose, arena, &colour_pass_storage);
     colour_pass = &colour_pass_storage;
   }
 

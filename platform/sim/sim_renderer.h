@@ -22,6 +22,7 @@
 #include "field_configs/season_config.h"
 #include "platform/drive_base.h"
 #include "platform/rgbd.h"
+#include "platform/sim/sim_arena.h"
 #include "platform/sim/sim_world.h"
 
 namespace slamo::platform {
@@ -34,6 +35,11 @@ struct RenderOptions {
   bool colour_depth_baseline = false;  // render colour from the colour camera's own position
   double black_albedo = 0.08;          // luminance below which the camera reads no depth
   double specular_dropout = 0.55;      // highlight strength above which no depth (reflective)
+  // Arena mode: beyond the perimeter a hall with a crowd, posters and lights drawn anew for
+  // every frame from the seed (sim_arena.h), and opponent robots as dark chassis with bumpers
+  // and a flag plate in their alliance's colour. Off: the clean field of the thesis.
+  bool arena = false;
+  ArenaOptions arena_options;
 };
 
 // Ids in FrameTruth::ids: 0 background / field, objects 1..N, landmarks kLandmarkIdBase + i,
@@ -90,12 +96,13 @@ class SimRenderer {
  private:
   struct Buffers;
   void RenderPass(const SimWorld& world, const Eigen::Isometry3d& world_from_camera,
-                  Buffers* out) const;
+                  const ArenaBackdrop* arena, Buffers* out) const;
   void BuildStaticPrimitives();
 
   const field::SeasonConfig& season_;
   field::CameraConfig camera_;
   RenderOptions options_;
+  uint64_t seed_;
   std::mt19937_64 rng_;
   std::vector<Eigen::Vector3f> rays_cam_;  // per pixel, z = 1
   std::vector<float> ray_length2_;         // per pixel, |ray|^2 (the same in every frame)
@@ -106,6 +113,7 @@ class SimRenderer {
   std::unique_ptr<Buffers> depth_buffers_;   // reused every frame
   std::unique_ptr<Buffers> colour_buffers_;  // with the colour-depth baseline only
   int64_t frame_index_ = 0;
+  ArenaBackdrop arena_;  // arena mode: this frame's
 };
 
 }  // namespace slamo::platform

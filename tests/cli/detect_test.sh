@@ -1,6 +1,6 @@
 #!/bin/sh
 # `slamo detect` as a user runs it: on an ordinary photo with a colours file, on a rendered
-# frame with depth, and on bad input (exit status 2, a message, no crash).
+# frame with depth and without it, and on bad input (exit status 2, a message, no crash).
 # Usage: detect_test.sh SLAMO_BINARY SOURCE_DIR
 set -u
 slamo=$1
@@ -23,6 +23,15 @@ out=$("$slamo" detect --color "$work/frame/colour.png" --depth "$work/frame/dept
 echo "$out"
 echo "$out" | grep -q "range" || fail "frame: no range in the output"
 [ -s "$work/seen.png" ] || fail "frame: no annotated picture"
+
+# The same frame without depth: every detection is typed and ranged on the ground plane.
+out=$("$slamo" detect --color "$work/frame/colour.png") || fail "no depth: exit $?"
+echo "$out"
+n=$(echo "$out" | grep -c "centre")
+typed=$(echo "$out" | grep "centre" | grep -c "(ground plane)")
+[ "$n" -ge 3 ] || fail "no depth: $n detections, expected at least 3"
+[ "$typed" -eq "$n" ] || fail "no depth: $typed of $n detections typed on the ground plane"
+echo "$out" | grep "centre" | grep -q "  -  " && fail "no depth: an untyped detection"
 
 # Bad input.
 expect_2() {  # expect_2 NAME PATTERN ARGS...

@@ -285,5 +285,82 @@ TEST(SimRendererSizesTest, RendersAt1920x1080) {
   EXPECT_GT(cv::countNonZero(frame.depth_mm), 1920 * 1080 / 4);
 }
 
+// Arena mode: the same seed draws the same hall, another seed (or the next frame) another;
+// everything on the field side of the perimeter is exactly the clean render, and the hall
+// beyond it has colour where the clean venue is dim grey, and depth where it is in range.
+TEST_F(SimRendererTest, ArenaIsSeededPerFrameAndOnlyChangesWhatLiesBeyondThePerimeter) {
+  const SimWorld world = WorldWith({Ball(1, "buckyball", "red", -0.6, 0.35)});
+  RenderOptions arena_options = Clean();
+  arena_options.arena = true;
+  SimRenderer clean(season_, robot_.camera, Clean(), 5);
+  SimRenderer a(season_, robot_.camera, arena_options, 5);
+  SimRenderer b(season_, robot_.camera, arena_options, 5);
+  SimRenderer c(season_, robot_.camera, arena_options, 6);
+  const Pose2D pose{0.8, 0.2, 0.3};  // near the +x wall: the hall in range of the depth camera
+  FrameTruth truth;
+  const RgbdFrame fclean = clean.Render(world, pose, 0.0, &truth);
+  const RgbdFrame fa = a.Render(world, pose, 0.0, nullptr);
+  const RgbdFrame fb = b.Render(world, pose, 0.0, nullptr);
+  const RgbdFrame fc = c.Render(world, pose, 0.0, nullptr);
+  const RgbdFrame fa_next = a.Render(world, pose, 0.1, nullptr);
+  EXPECT_EQ(cv::norm(fa.colour, fb.colour, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(fa.depth_mm, fb.depth_mm, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(fa.colour, fc.colour, cv::NORM_L1), 0.0);
+  EXPECT_GT(cv::norm(fa.colour, fa_next.colour, cv::NORM_L1), 0.0);
+
+  int field_side = 0, field_side_same = 0, beyond = 0, beyond_changed = 0, beyond_depth = 0;
+  for (int v = 0; v < fclean.colour.rows; ++v) {
+    for (int u = 0; u < fclean.colour.cols; ++u) {
+      const bool same = fclean.colour.at<cv::Vec3b>(v, u) == fa.colour.at<cv::Vec3b>(v, u) &&
+                        fclean.depth_mm.at<uint16_t>(v, u) == fa.depth_mm.at<uint16_t>(v, u);
+      if (truth.ids.at<uint16_t>(v, u) != 0 || fclean.depth_mm.at<uint16_t>(v, u) != 0) {
+        ++field_side;  // floor, walls, markers, the ball: all in range here
+        field_side_same += same;
+      } else {
+        ++beyond;
+        beyond_changed += !same;
+        beyond_depth += fa.depth_mm.at<uint16_t>(v, u) != 0;
+      }
+    }
+  }
+  EXPECT_GT(field_side, 20000);
+  EXPECT_EQ(field_side_same, field_side);
+  EXPECT_GT(beyond, 20000);
+  EXPECT_GT(beyond_changed, beyond * 9 / 10);
+  EXPECT_GT(beyond_depth, 1000);
+}
+
+// Arena mode draws an opponent as a dark chassis with bumpers and a flag in its alliance's
+// colour; the clean mode as one dim box in that colour.
+TEST_F(SimRendererTest, ArenaOpponentHasAllianceColouredBumpersOnADarkChassis) {
+  SimWorld world = WorldWith({});
+  SimOpponent opponent;
+  opponent.config.alliance = field::Alliance::kRed;
+  opponent.config.size_m = {0.45, 0.45};
+  opponent.pose = Pose2D{0.2, 0.3, 0.5};
+  world.opponents = {opponent};
+  RenderOptions arena_options = Clean();
+  arena_options.arena = true;
+  for (const bool arena : {false, true}) {
+    SimRenderer renderer(season_, robot_.camera, arena ? arena_options : Clean(), 3);
+    FrameTruth truth;
+    const RgbdFrame frame = renderer.Render(world, pose_, 0.0, &truth);
+    int pixels = 0, red = 0, dark_grey = 0;
+    for (int v = 0; v < frame.colour.rows; ++v) {
+      for (int u = 0; u < frame.colour.cols; ++u) {
+        if (truth.ids.at<uint16_t>(v, u) != kOpponentIdBase) continue;
+        const cv::Vec3b bgr = frame.colour.at<cv::Vec3b>(v, u);
+        ++pixels;
+        red += bgr[2] > 2 * bgr[1] && bgr[2] > 2 * bgr[0];
+        dark_grey += std::abs(bgr[2] - bgr[0]) < 20 && bgr[2] < 100;
+      }
+    }
+    SCOPED_TRACE(arena ? "arena" : "clean");
+    EXPECT_GT(pixels, 2000);
+    EXPECT_GT(red, arena ? 300 : pixels * 9 / 10);
+    EXPECT_EQ(dark_grey > pixels / 3, arena);
+  }
+}
+
 }  // namespace
 }  // namespace slamo::platform

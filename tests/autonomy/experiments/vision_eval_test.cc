@@ -1,0 +1,67 @@
+#include "autonomy/experiments/vision_eval.h"
+
+#include <gtest/gtest.h>
+
+#include "field_configs/loader.h"
+
+namespace slamo::autonomy {
+namespace {
+
+std::vector<VisionMethodScore> Scores(const std::string& season_name, int frames, uint64_t seed,
+                                      bool arena, VisionEvalOptions options = {}) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(season_name);
+  options.frames = frames;
+  options.seed = seed;
+  options.arena = arena;
+  return EvaluateVision(season, field::LoadRobotConfig("thesis_robot"), options);
+}
+
+// In the arena, the field gate drops the crowd, posters and lights beyond the perimeter:
+// precision with it beats precision without it by a wide margin for every method, and it
+// drops no real object. Measured with `slamo eval vision --season toss_up --arena --frames 10
+// --seed 1`: +0.35 for the smallest gain (0.837 against 0.488 for threshold+defects), no
+// object dropped; the test asks for +0.25.
+TEST(VisionEvalTest, ArenaPrecisionIsBetterWithTheFieldGate) {
+  const std::vector<VisionMethodScore> scores = Scores("toss_up", 10, 1, true);
+  ASSERT_EQ(scores.size(), 6u);
+  for (const VisionMethodScore& s : scores) {
+    SCOPED_TRACE(s.name);
+    EXPECT_GT(s.rejected_by_geometry, 10);
+    EXPECT_EQ(s.rejected_objects, 0);
+    EXPECT_GT(s.Precision(), s.RawPrecision() + 0.25);
+    EXPECT_GT(s.expected, 20);
+  }
+}
+
+// The same seed gives the same scores; the clean field (no arena) has almost nothing for the
+// gate to drop.
+TEST(VisionEvalTest, DeterministicPerSeedAndTheCleanFieldHasLittleToReject) {
+  const std::vector<VisionMethodScore> a = Scores("over_under", 4, 3, true);
+  const std::vector<VisionMethodScore> b = Scores("over_under", 4, 3, true);
+  EXPECT_EQ(FormatVisionTable(a), FormatVisionTable(b));
+  const std::vector<VisionMethodScore> clean = Scores("over_under", 4, 3, false);
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_LT(clean[k].rejected_by_geometry, a[k].rejected_by_geometry) << a[k].name;
+  }
+}
+
+// Shapes per type (#16 item 3): Starstruck's stars have concave outlines of their own, which
+// the concave-defect cut took for touching objects, and the pieces failed the shape and size
+// tests. With depth, a blob no larger than one star or cube can look is not cut. Measured with
+// `slamo eval vision --season starstruck --frames 10 --seed 1`, threshold+defects: recall
+// 0.958 with the rule, 0.583 without it (extent_margin_px -1e9); the test asks for +0.2.
+TEST(VisionEvalTest, StarsAreFoundWholeOnlyWithTheSizeRule) {
+  const auto recall = [](const std::vector<VisionMethodScore>& scores) {
+    return scores.at(0).Recall();  // threshold+defects
+  };
+  VisionEvalOptions without;
+  without.detect.extent_margin_px = -1e9;
+  const std::vector<VisionMethodScore> with_rule = Scores("starstruck", 10, 1, false);
+  const std::vector<VisionMethodScore> without_rule = Scores("starstruck", 10, 1, false, without);
+  ASSERT_EQ(with_rule.at(0).name, "threshold+defects");
+  EXPECT_GT(recall(with_rule), recall(without_rule) + 0.2);
+  EXPECT_GE(with_rule.at(0).Precision(), without_rule.at(0).Precision());
+}
+
+}  // namespace
+}  // namespace slamo::autonomy

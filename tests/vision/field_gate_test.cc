@@ -1,0 +1,170 @@
+#include "vision/field_gate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "field_configs/loader.h"
+#include "platform/sim/sim_renderer.h"
+#include "platform/sim/sim_world.h"
+#include "vision/detector.h"
+
+namespace slamo::vision {
+namespace {
+
+using platform::Pose2D;
+using platform::SimObject;
+
+class FieldGateTest : public ::testing::Test {
+ protected:
+  FieldGateTest()
+      : season_(field::LoadSeasonConfig("toss_up")),
+        robot_(field::LoadRobotConfig("thesis_robot")),
+        camera_(robot_.camera),
+        bounds_(FieldBoundsOf(season_)) {}
+
+  // A detection with a depth measurement at `world` seen from `pose_`.
+  Detection At(const Eigen::Vector3d& world) const {
+    const double c = std::cos(pose_.z()), s = std::sin(pose_.z());
+    const Eigen::Vector2d rel(world.x() - pose_.x(), world.y() - pose_.y());
+    Measurement m;
+    m.position_robot_m =
+        Eigen::Vector3d(c * rel.x() + s * rel.y(), -s * rel.x() + c * rel.y(), world.z());
+    m.range_m = m.position_robot_m.head<2>().norm();
+    m.bearing_rad = std::atan2(m.position_robot_m.y(), m.position_robot_m.x());
+    m.covariance = Eigen::Vector2d(0.01 * 0.01, 0.005 * 0.005).asDiagonal();
+    m.depth_pixels = 100;
+    Detection d;
+    d.colour = "red";
+    d.measurement = m;
+    return d;
+  }
+
+  // A detection without a measurement whose lowest pixel is (u, v).
+  static Detection Blob(int u, int v) {
+    Detection d;
+    d.colour = "red";
+    d.box = cv::Rect(u - 5, v - 10, 11, 11);
+    d.contour = {{u - 5, v - 10}, {u + 5, v - 10}, {u, v}};
+    return d;
+  }
+
+  field::SeasonConfig season_;
+  field::RobotConfig robot_;
+  CameraModel camera_;
+  FieldBounds bounds_;
+  const Eigen::Vector3d pose_{-1.0, 0.2, 0.3};
+};
+
+// The bounds come from the season file: the perimeter's size, the tallest object (Toss Up's
+// large ball is taller than the wall) and the stashes objects are scored into.
+TEST_F(FieldGateTest, BoundsComeFromTheSeasonFile) {
+  EXPECT_DOUBLE_EQ(bounds_.half_size_m, season_.HalfSize());
+  EXPECT_DOUBLE_EQ(bounds_.floor_top_m, season_.FindObjectType("large_ball")->height_m);
+  EXPECT_GT(bounds_.floor_top_m, season_.field.wall_height_m);
+  ASSERT_EQ(bounds_.raised.size(), 2u);  // red and blue stash
+  EXPECT_NEAR(bounds_.raised[0].top_m, 0.76 + 0.40, 1e-9);
+  field::SeasonConfig wider = season_;
+  wider.field.size_m = 5.0;
+  EXPECT_DOUBLE_EQ(FieldBoundsOf(wider).half_size_m, 2.5);
+}
+
+// Planted detections with positions: off the field or above every object top go, the rest
+// stay, and the count says how many went.
+TEST_F(FieldGateTest, PositionsOffTheFieldOrTooHighAreRejected) {
+  const double half = season_.HalfSize();
+  const std::vector<Detection> planted = {
+      At({0.5, 0.3, 0.06}),          // on the floor: kept
+      At({half - 0.07, 1.0, 0.06}),  // against the wall: kept
+      At({half + 0.8, 0.0, 0.5}),    // a poster beyond the wall: rejected
+      At({0.0, -half - 0.5, 0.06}),  // beyond the side wall at floor height: rejected
+      At({0.0, 0.0, 0.9}),           // above the open field: rejected
+      At({0.45, 0.61, 0.9}),         // in the red stash, above the wall: kept
+  };
+  int rejected = 0;
+  const std::vector<Detection> kept =
+      RejectOffField(planted, camera_, pose_, bounds_, FieldGateOptions{}, {}, &rejected);
+  EXPECT_EQ(rejected, 3);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_NEAR(kept[0].measurement->position_robot_m.z(), 0.06, 1e-12);
+  EXPECT_NEAR(kept[2].measurement->position_robot_m.z(), 0.9, 1e-12);
+  // The pose's uncertainty widens the field: a detection 0.1 m beyond the wall stays when
+  // the pose is known to 0.1 m only.
+  const Detection just_beyond = At({half + 0.1, 0.0, 0.06});
+  EXPECT_FALSE(OnField(just_beyond, camera_, pose_, bounds_));
+  FieldGateOptions loose;
+  loose.pose_sigma_m = 0.1;
+  EXPECT_TRUE(OnField(just_beyond, camera_, pose_, bounds_, loose));
+}
+
+// Without a position: a blob low in the image is on the floor; one at the top of the image
+// looks over the wall from a robot facing it.
+TEST_F(FieldGateTest, WithoutDepthTheRayMustComeDownIntoTheField) {
+  const Eigen::Vector3d facing_wall(0.8, 0.0, 0.0);
+  const int w = robot_.camera.width_px, h = robot_.camera.height_px;
+  EXPECT_TRUE(OnField(Blob(w / 2, h - 5), camera_, facing_wall, bounds_));
+  EXPECT_FALSE(OnField(Blob(w / 2, 10), camera_, facing_wall, bounds_));
+}
+
+// Against the renderer: in an arena frame facing a wall, the gate drops detections on the
+// stands and keeps every detection of a real object.
+TEST_F(FieldGateTest, ArenaFrameLosesStandsNotObjects) {
+  platform::SimWorld world = platform::CreateWorld(season_, 4);
+  platform::RenderOptions options;
+  options.arena = true;
+  const DetectorSetup setup = ObjectDetectorSetup(season_, &robot_.camera);
+  int rejected_objects = 0, rejected_total = 0, kept_objects = 0;
+  for (int k = 0; k < 6; ++k) {
+    const Pose2D pose{0.6 - 0.3 * k, -0.6 + 0.2 * k, 0.4 * k};
+    platform::SimRenderer renderer(season_, robot_.camera, options, 11 + k);
+    platform::FrameTruth truth;
+    const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, &truth);
+    for (const Detection& d : Detect(frame.colour, frame.depth_mm, setup, DetectOptions{})) {
+      const int id = truth.ids.at<uint16_t>(cv::Point(d.centre_px));
+      const bool object = id > 0 && id < platform::kLandmarkIdBase;
+      const bool on = OnField(d, camera_, {pose.x_m, pose.y_m, pose.theta_rad}, bounds_);
+      rejected_total += !on;
+      rejected_objects += object && !on;
+      kept_objects += object && on;
+    }
+  }
+  EXPECT_GT(rejected_total, 5);
+  EXPECT_EQ(rejected_objects, 0);
+  EXPECT_GT(kept_objects, 5);
+}
+
+// Item 2's last part: without depth, a ball on the floor gets its type from its apparent
+// size at the ground-plane range, and that range is close to the truth.
+TEST_F(FieldGateTest, WithoutDepthTypeAndRangeComeFromTheGroundPlane) {
+  platform::SimWorld world = platform::CreateWorld(season_, 3);
+  const auto ball = [&](int id, const std::string& type, double x, double y) {
+    SimObject o;
+    o.id = id;
+    o.type = season_.FindObjectType(type);
+    o.colour = "red";
+    o.center_m = Eigen::Vector3d(x, y, o.type->size_m / 2.0);
+    return o;
+  };
+  world.objects = {ball(1, "buckyball", -0.5, 0.3), ball(2, "large_ball", 0.3, -0.2)};
+  const Pose2D pose{-1.4, 0.1, 0.0};
+  platform::SimRenderer renderer(season_, robot_.camera, platform::RenderOptions{}, 3);
+  const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, nullptr);
+  DetectOptions kmeans;  // the large ball is semi-transparent
+  kmeans.method = DetectMethod::kKMeans;
+  const std::vector<Detection> found =
+      Detect(frame.colour, cv::Mat(), ObjectDetectorSetup(season_, &robot_.camera), kmeans);
+  ASSERT_EQ(found.size(), 2u);
+  for (const Detection& d : found) {
+    ASSERT_TRUE(d.measurement.has_value());
+    EXPECT_EQ(d.measurement->depth_pixels, 0);
+    const SimObject& truth = d.kind == "buckyball" ? world.objects[0] : world.objects[1];
+    ASSERT_TRUE(d.kind == "buckyball" || d.kind == "large_ball") << d.kind;
+    const double true_range =
+        std::hypot(truth.center_m.x() - pose.x_m - 0.0, truth.center_m.y() - pose.y_m);
+    EXPECT_NEAR(d.measurement->range_m, true_range, 0.05) << d.kind;
+  }
+  EXPECT_NE(found[0].kind, found[1].kind);
+}
+
+}  // namespace
+}  // namespace slamo::vision

@@ -1,0 +1,71 @@
+// What the field's geometry says about a detection. An object resting on the floor and seen
+// without depth gets its range from where the ray through its centre meets the plane of its
+// centre (the camera's mount is known), and its type from its apparent size at that range.
+// A detection that cannot be an object on this field is dropped: with a position (depth or
+// the ground plane), one outside the perimeter or above anything the season places; without
+// one, one whose lowest pixel's ray never comes down into the field's box (it looks over the
+// perimeter wall at the stands). The field's size and height come from the season file.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "field_configs/season_config.h"
+#include "vision/camera_model.h"
+#include "vision/measurement.h"
+
+namespace slamo::vision {
+
+struct Detection;
+
+// Where objects can be: inside the perimeter's inner faces, from the floor up to the tallest
+// object resting on it (at least the perimeter wall's top), and higher only over the places
+// the season raises them: goals objects go into (up to the opening plus the tallest object)
+// and objects placed above the floor (stacks, objects on structures).
+struct FieldBounds {
+  double half_size_m = 0.0;  // the perimeter's inner faces at x, y = +-half_size_m
+  double floor_top_m = 0.0;  // max(wall top, tallest object type)
+  struct Column {
+    Eigen::Vector2d min_m = Eigen::Vector2d::Zero(), max_m = Eigen::Vector2d::Zero();
+    double top_m = 0.0;
+  };
+  std::vector<Column> raised;
+};
+FieldBounds FieldBoundsOf(const field::SeasonConfig& season);
+
+struct FieldGateOptions {
+  // How far outside the bounds a detection may be, in standard deviations of its position
+  // (its measurement covariance and the pose's), before it is dropped.
+  double sigmas = 3.0;
+  double pose_sigma_m = 0.0;  // 1 sigma of the robot's position estimate
+};
+
+// The measurement of an object resting on the floor (its centre centre_height_m above the
+// floor) seen at centre_px, without depth: the ray through the centre meets the plane
+// z = centre_height_m in the robot frame. nullopt when the ray does not come down to it.
+// The covariance propagates the pixel uncertainty (options.pixel_sigma_px plus
+// options.pixel_sigma_ratio x radius_px) through that intersection.
+std::optional<Measurement> GroundPlaneMeasurement(const CameraModel& camera,
+                                                  const cv::Point2d& centre_px, double radius_px,
+                                                  double centre_height_m,
+                                                  const MeasurementOptions& options = {});
+
+// Whether a detection can be an object on the field, seen by `camera` from the robot at
+// `robot_pose` (x_m, y_m, heading_rad; the estimate).
+bool OnField(const Detection& detection, const CameraModel& camera,
+             const Eigen::Vector3d& robot_pose, const FieldBounds& bounds,
+             const FieldGateOptions& options = {},
+             const MeasurementOptions& measurement_options = {});
+
+// The detections OnField keeps, in order; *rejected (when given) counts the others.
+std::vector<Detection> RejectOffField(const std::vector<Detection>& detections,
+                                      const CameraModel& camera, const Eigen::Vector3d& robot_pose,
+                                      const FieldBounds& bounds,
+                                      const FieldGateOptions& options = {},
+                                      const MeasurementOptions& measurement_options = {},
+                                      int* rejected = nullptr);
+
+}  // namespace slamo::vision
