@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -55,6 +56,7 @@ const std::map<std::string, std::string>& TunableParams() {
       {"arrival_frames", "planner: frames to check an arrival"},
       {"observe_first", "planner: 1 weighs observing before a cycle (frames 5, 10, 20); 0 never"},
       {"gyro", "1: a yaw gyro's heading into SLAM-O; 0: encoders and camera only"},
+      {"adaptive", "1: the EKF's adaptive noise (NIS, sensor/motion checks, re-acquire); 0: off"},
       {"planner", "OMPL planner: rrtconnect | rrtstar | informedrrtstar | prmstar | bitstar"},
   };
   return params;
@@ -99,6 +101,10 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     if (value != "0" && value != "1")
       throw std::invalid_argument("--param gyro: expected 0 or 1, got \"" + value + "\"");
     setup->gyro = value == "1";
+  } else if (name == "adaptive") {
+    if (value != "0" && value != "1")
+      throw std::invalid_argument("--param adaptive: expected 0 or 1, got \"" + value + "\"");
+    setup->adaptive_filter = value == "1";
   } else if (name == "planner") {
     const auto& names = planning::PlannerNames();
     if (std::find(names.begin(), names.end(), value) == names.end()) {
@@ -161,6 +167,10 @@ nlohmann::json ToJson(const MatchOutcome& o) {
           {"overrun_s", o.overrun_s},
           {"refused", o.refused},
           {"pose_ate_m", o.pose_ate_m},
+          {"nees_updates", o.nees_updates},
+          {"nees_honest", o.nees_honest},
+          {"attempts", o.attempts},
+          {"attempts_inside", o.attempts_inside},
           {"duration_s", o.duration_s},
           {"wall_s", o.wall_s},
           {"failed", o.failed},
@@ -176,6 +186,10 @@ MatchOutcome OutcomeFromJson(const nlohmann::json& j) {
   o.overrun_s = j.at("overrun_s").get<double>();
   o.refused = j.at("refused").get<int>();
   o.pose_ate_m = j.at("pose_ate_m").get<double>();
+  o.nees_updates = j.value("nees_updates", 0);
+  o.nees_honest = j.value("nees_honest", 0);
+  o.attempts = j.value("attempts", 0);
+  o.attempts_inside = j.value("attempts_inside", 0);
   o.duration_s = j.at("duration_s").get<double>();
   o.wall_s = j.at("wall_s").get<double>();
   o.failed = j.at("failed").get<bool>();
@@ -218,6 +232,10 @@ std::vector<MatchOutcome> RunTasks(const field::SeasonConfig& season,
         o.overrun_s = r.overrun_s;
         o.refused = r.refused;
         o.pose_ate_m = r.pose_ate_m;
+        o.nees_updates = r.consistency.updates;
+        o.nees_honest = r.consistency.in_band + r.consistency.below;
+        o.attempts = static_cast<int>(r.attempts.size());
+        for (const AttemptCheck& a : r.attempts) o.attempts_inside += a.Inside();
         o.duration_s = r.duration_s;
         o.wall_s = r.wall_s;
       } catch (const std::exception& e) {
@@ -282,6 +300,7 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
     ComboSummary s;
     s.combo = combo;
     std::vector<double> points, gained;
+    int updates = 0, honest = 0, attempts = 0, inside = 0;
     for (const MatchOutcome* o : by_combo[combo]) {
       if (o->failed) {
         ++s.failed;
@@ -293,6 +312,8 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
       if (o->overrun_s > 0.0) ++s.overruns;
       s.mean_overrun_s += o->overrun_s;
       s.mean_ate_m += o->pose_ate_m;
+      updates += o->nees_updates, honest += o->nees_honest;
+      attempts += o->attempts, inside += o->attempts_inside;
       s.mean_wall_s += o->wall_s;
     }
     const auto mean_ci = [](const std::vector<double>& v, double* mean, double* ci) {
@@ -305,6 +326,9 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
       for (double x : v) ss += (x - *mean) * (x - *mean);
       *ci = 1.96 * std::sqrt(ss / (v.size() - 1)) / std::sqrt(static_cast<double>(v.size()));
     };
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    s.nees_honest_fraction = updates ? static_cast<double>(honest) / updates : nan;
+    s.attempts_inside_fraction = attempts ? static_cast<double>(inside) / attempts : nan;
     mean_ci(points, &s.mean_points, &s.ci95_points);
     mean_ci(gained, &s.mean_gained, &s.ci95_gained);
     if (s.matches > 0) {
@@ -324,13 +348,14 @@ std::string SummaryCsv(const std::vector<ComboSummary>& rows) {
   std::ostringstream out;
   out << "rank,combo,matches,failed,mean_points,ci95_points,mean_gained,ci95_gained,overruns,mean_"
          "overrun_s,"
-         "mean_ate_m,mean_wall_s\n";
+         "mean_ate_m,nees_honest_fraction,attempts_inside_fraction,mean_wall_s\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
     out << ++rank << ",\"" << r.combo << "\"," << r.matches << ',' << r.failed << ','
         << r.mean_points << ',' << r.ci95_points << ',' << r.mean_gained << ',' << r.ci95_gained
         << ',' << r.overruns << ',' << r.mean_overrun_s << ',' << r.mean_ate_m << ','
-        << r.mean_wall_s << '\n';
+        << r.nees_honest_fraction << ',' << r.attempts_inside_fraction << ',' << r.mean_wall_s
+        << '\n';
   }
   return out.str();
 }
@@ -350,6 +375,8 @@ nlohmann::json SummaryJson(const std::vector<ComboSummary>& rows,
                             {"overruns", r.overruns},
                             {"mean_overrun_s", r.mean_overrun_s},
                             {"mean_ate_m", r.mean_ate_m},
+                            {"nees_honest_fraction", r.nees_honest_fraction},
+                            {"attempts_inside_fraction", r.attempts_inside_fraction},
                             {"mean_wall_s", r.mean_wall_s}});
   }
   j["matches"] = nlohmann::json::array();
@@ -361,7 +388,7 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
   out << std::left << std::setw(5) << "rank" << std::setw(40) << "parameters" << std::right
       << std::setw(8) << "matches" << std::setw(18) << "points (95% CI)" << std::setw(18)
       << "gained (95% CI)" << std::setw(10) << "overruns" << std::setw(10) << "ATE m"
-      << std::setw(10) << "wall s"
+      << std::setw(10) << "NEES ok" << std::setw(10) << "in 3sig" << std::setw(10) << "wall s"
       << "\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
@@ -371,8 +398,9 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
     out << std::left << std::setw(5) << ++rank << std::setw(40) << r.combo << std::right
         << std::setw(8) << r.matches << std::setw(18) << points.str() << std::setw(18)
         << gained.str() << std::setw(10) << r.overruns << std::setw(10) << std::fixed
-        << std::setprecision(3) << r.mean_ate_m << std::setw(10) << std::setprecision(2)
-        << r.mean_wall_s << "\n";
+        << std::setprecision(3) << r.mean_ate_m << std::setw(10) << std::setprecision(3)
+        << r.nees_honest_fraction << std::setw(10) << r.attempts_inside_fraction << std::setw(10)
+        << std::setprecision(2) << r.mean_wall_s << "\n";
     if (r.failed) out << "     (" << r.failed << " matches failed: see tune.json)\n";
   }
 }

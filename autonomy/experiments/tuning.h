@@ -40,6 +40,8 @@ struct MatchOutcome {
   double overrun_s = 0.0;
   int refused = 0;
   double pose_ate_m = 0.0;
+  int nees_updates = 0, nees_honest = 0;  // filter updates; NEES in its band or below
+  int attempts = 0, attempts_inside = 0;  // picks/scores; true error inside the 3-sigma
   double duration_s = 0.0;
   double wall_s = 0.0;
   bool failed = false;  // the match process crashed or threw
@@ -71,6 +73,8 @@ struct ComboSummary {
   int overruns = 0;  // matches with motors driven after the deadline
   double mean_overrun_s = 0.0;
   double mean_ate_m = 0.0;
+  double nees_honest_fraction = 0.0;      // over all updates: NEES in its band or below
+  double attempts_inside_fraction = 0.0;  // over all picks/scores: error inside 3-sigma
   double mean_wall_s = 0.0;
 };
 // Per combination, ranked by mean points (best first).

@@ -5,6 +5,7 @@
 // how it went, and go round again until the deadline.
 #include "autonomy/loop/executive.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -12,12 +13,32 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "strategy/strategy.h"
 
 namespace slamo::autonomy {
 namespace {
 
 using strategy::ActionKind;
+
+// The robot's true position error and the filter's 3-sigma now; none without the truth.
+std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const std::string& action) {
+  const std::optional<platform::Pose2D> truth = world.io().TruePose();
+  if (!truth) return std::nullopt;
+  AttemptCheck c;
+  c.t_s = world.now_s();
+  c.action = action;
+  c.estimate_m = world.slam().pose().head<2>();
+  c.truth_m = Eigen::Vector2d(truth->x_m, truth->y_m);
+  c.error_m = (c.estimate_m - c.truth_m).norm();
+  const Eigen::Matrix2d position = world.slam().pose_covariance().topLeftCorner<2, 2>();
+  c.three_sigma_m =
+      3.0 *
+      std::sqrt(std::max(
+          0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position).eigenvalues().maxCoeff()));
+  return c;
+}
 
 // Tracked objects against where the objects really are at the end.
 std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
@@ -138,6 +159,9 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
     // 4. Carry it out. The deadline, part two: every motion inside stops when the clock
     //    reaches it (DriveControllerOptions::hard_deadline_s), whatever the action.
     world.set_action_label(entry.action + " " + action.why);
+    std::optional<AttemptCheck> attempt;
+    if (action.kind == ActionKind::kPick || action.kind == ActionKind::kScore)
+      attempt = CheckAttempt(world, entry.action);
     bool ok = false;
     switch (action.kind) {
       case ActionKind::kObserve:
@@ -165,6 +189,10 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
 
     // 5. Tell the strategy, and account for the time.
     strategy->Feedback(action, ok);
+    if (attempt) {
+      attempt->ok = ok;
+      result.attempts.push_back(*attempt);
+    }
     entry.ok = ok;
     entry.end_s = world.now_s();
     const double spent = entry.end_s - entry.t_s;
@@ -191,6 +219,7 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
   result.overrun_s = world.overrun_s();
   result.duration_s = std::min(world.last_motion_s(), world.deadline_s() + result.overrun_s);
   result.pose_ate_m = PoseAte(world.samples());
+  result.consistency = PoseConsistencyOf(world.samples());
   result.frames_taken = world.frames();
   result.replans = world.replans();
   result.relocalisations = world.relocalisations();

@@ -38,6 +38,19 @@ struct ObjectReport {
   double error_m = 0.0;
 };
 
+// A pick or score attempt against the truth, when it began: the robot's position error and the
+// filter's 3-sigma (three times the position covariance's longest axis).
+struct AttemptCheck {
+  double t_s = 0.0;
+  std::string action;  // PICK or SCORE
+  bool ok = false;     // what the action reported
+  Eigen::Vector2d estimate_m = Eigen::Vector2d::Zero();
+  Eigen::Vector2d truth_m = Eigen::Vector2d::Zero();
+  double error_m = 0.0;
+  double three_sigma_m = 0.0;
+  bool Inside() const { return error_m <= three_sigma_m; }
+};
+
 struct MatchResult {
   std::string robot_io;                 // what the match ran on (RobotIo::Describe)
   bool truth_known = true;              // false on hardware: points and object errors are unknown
@@ -60,7 +73,9 @@ struct MatchResult {
   int relocalisations = 0;      // frames paired again after widening a lost pose belief
   int rejected_frames = 0;      // frames whose update would have thrown the pose off
   double odometry_scale = 1.0;  // true distance per encoder distance, calibrated before the match
-  double wall_s = 0.0;          // compute time of the run on this machine
+  PoseConsistency consistency;  // the pose NEES at every update (when the truth is known)
+  std::vector<AttemptCheck> attempts;  // every pick and score attempt (when the truth is known)
+  double wall_s = 0.0;                 // compute time of the run on this machine
   std::vector<ObjectReport> objects;
   std::vector<TimelineEntry> timeline;
   std::vector<PoseSample> samples;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "mapping/ekf_slam.h"
 #include "mapping/metrics.h"
 #include "platform/field_geometry.h"
 
@@ -49,6 +50,29 @@ field::RobotConfig MatchRobot(const field::RobotConfig& robot, double speed_mps)
 
 }  // namespace
 
+double PoseConsistency::HonestFraction() const {
+  return updates ? static_cast<double>(in_band + below) / updates
+                 : std::numeric_limits<double>::quiet_NaN();
+}
+
+PoseConsistency PoseConsistencyOf(const std::vector<PoseSample>& samples) {
+  PoseConsistency c;
+  std::tie(c.band_low, c.band_high) = mapping::NeesBand(3, 1);
+  for (const PoseSample& s : samples) {
+    if (!s.truth_known) continue;
+    ++c.updates;
+    const double nees = mapping::PoseNees(s.truth, s.estimate, s.covariance);
+    if (nees < c.band_low) {
+      ++c.below;
+    } else if (nees > c.band_high) {
+      ++c.above;
+    } else {
+      ++c.in_band;
+    }
+  }
+  return c;
+}
+
 double PoseAte(const std::vector<PoseSample>& samples) {
   std::vector<Eigen::Vector2d> truth, estimate;
   for (const PoseSample& s : samples) {
@@ -61,7 +85,7 @@ double PoseAte(const std::vector<PoseSample>& samples) {
 }
 
 mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
-                            const platform::Pose2D& start, bool relocalise) {
+                            const platform::Pose2D& start, bool relocalise, bool adaptive) {
   mapping::SlamOPrior prior;
   prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
   prior.covariance = Eigen::Vector3d(1e-4, 1e-4, std::pow(kPi / 180.0, 2)).asDiagonal();
@@ -72,6 +96,7 @@ mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::Robot
   options.ekf.motion = mapping::MotionNoiseFor(robot.odometry_noise);
   options.ekf.max_range_m = robot.camera.max_range_m;
   options.ekf.add_landmarks = false;
+  options.ekf.adaptive.enabled = adaptive;
   options.relocalise = relocalise;
   return mapping::SlamO(field, robot.camera, prior, options);
 }
@@ -86,7 +111,8 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
       deadline_s_(season.rules.autonomous_s),
       io_(std::move(io)),
       slam_(SurveyedSlam(field_, robot_,
-                         platform::StartPose(field_, setup.alliance, setup.start_index), true)),
+                         platform::StartPose(field_, setup.alliance, setup.start_index), true,
+                         setup.adaptive_filter)),
       travel_(robot_.drive) {
   const Pose2D start_pose = platform::StartPose(field_, setup.alliance, setup.start_index);
   io_->Start(field_, robot_, start_pose);

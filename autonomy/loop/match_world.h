@@ -54,6 +54,7 @@ struct MatchSetup {
   double pushable_fraction = 1.0;
   bool gyro =
       true;  // the turn of every motion from a yaw gyro, not the encoders (VEX robots carry one)
+  bool adaptive_filter = false;  // the EKF's adaptive noise (mapping::AdaptiveOptions)
 };
 
 // A moment of the match for the replay and the map picture.
@@ -86,6 +87,17 @@ struct PoseSample {
 // The pose ATE over the samples whose truth is known: the RMS position error at the same
 // instants, without alignment (mapping::PairedTrajectoryError); NaN when none is.
 double PoseAte(const std::vector<PoseSample>& samples);
+
+// The filter against the truth at every update: the pose NEES (3 dof) against one update's
+// 95 % band. Below the band the filter is conservative, above it overconfident.
+struct PoseConsistency {
+  int updates = 0;  // samples whose truth is known
+  int in_band = 0, below = 0, above = 0;
+  double band_low = 0.0, band_high = 0.0;
+  // In the band or conservative, over the updates (NaN: none).
+  double HonestFraction() const;
+};
+PoseConsistency PoseConsistencyOf(const std::vector<PoseSample>& samples);
 
 class MatchWorld {
  public:
@@ -187,8 +199,9 @@ class MatchWorld {
 
 // SLAM-O as a match runs it: from `start`, known to a centimetre and a degree, over the
 // season's surveyed markers, known to a millimetre and all there is (no new landmarks); with
-// `relocalise`, a belief that left the truth is widened and paired again.
+// `relocalise`, a belief that left the truth is widened and paired again; with `adaptive`, the
+// EKF checks its noise against what it observes (mapping::AdaptiveOptions).
 mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
-                            const platform::Pose2D& start, bool relocalise);
+                            const platform::Pose2D& start, bool relocalise, bool adaptive = false);
 
 }  // namespace slamo::autonomy

@@ -11,14 +11,17 @@
 #include <opencv2/videoio.hpp>
 
 #include "autonomy/reports/field_picture.h"
+#include "mapping/ekf_slam.h"
 #include "mapping/metrics.h"
 
 namespace slamo::autonomy {
 namespace {
 
 const cv::Scalar kTruth(30, 30, 30);
-const cv::Scalar kEstimate(0, 120, 255);  // orange
-const cv::Scalar kPath(200, 120, 0);      // blue
+const cv::Scalar kEstimate(0, 120, 255);        // orange
+const cv::Scalar kPath(200, 120, 0);            // blue
+const cv::Scalar kAttemptInside(40, 160, 40);   // green
+const cv::Scalar kAttemptOutside(30, 30, 220);  // red
 
 cv::Scalar Palette(const field::SeasonConfig& season, const std::string& name) {
   const auto it = season.colours.find(name);
@@ -105,6 +108,38 @@ nlohmann::json ReportJson(const MatchResult& r) {
     j["pose_ate_m"] = nullptr;
   } else {
     j["pose_ate_m"] = r.pose_ate_m;
+  }
+  if (r.consistency.updates > 0) {
+    // The filter against the truth at every update, and at every pick and score attempt.
+    const PoseConsistency& c = r.consistency;
+    j["nees"] = {{"band", {c.band_low, c.band_high}},
+                 {"updates", c.updates},
+                 {"in_band", c.in_band},
+                 {"conservative", c.below},
+                 {"overconfident", c.above},
+                 {"in_band_or_conservative_fraction", c.HonestFraction()}};
+    j["updates"] = nlohmann::json::array();
+    for (const PoseSample& s : r.samples) {
+      if (!s.truth_known) continue;
+      j["updates"].push_back({{"t_s", s.t_s},
+                              {"error_m", (s.estimate.head<2>() - s.truth.head<2>()).norm()},
+                              {"sigma_m", std::sqrt(s.covariance(0, 0) + s.covariance(1, 1))},
+                              {"nees", mapping::PoseNees(s.truth, s.estimate, s.covariance)}});
+    }
+  }
+  if (r.truth_known) {
+    j["attempts"] = nlohmann::json::array();
+    int inside = 0;
+    for (const AttemptCheck& a : r.attempts) {
+      inside += a.Inside();
+      j["attempts"].push_back({{"t_s", a.t_s},
+                               {"action", a.action},
+                               {"ok", a.ok},
+                               {"error_m", a.error_m},
+                               {"three_sigma_m", a.three_sigma_m},
+                               {"inside_three_sigma", a.Inside()}});
+    }
+    j["attempts_inside_three_sigma"] = inside;
   }
   if (!r.board.empty()) j["board"] = r.board;
   j["seconds"] = {{"observe", r.observe_s},
@@ -203,6 +238,14 @@ cv::Mat DrawMatchMap(const MatchResult& r) {
     cv::line(image, canvas.ToPixel(a.estimate.x(), a.estimate.y()),
              canvas.ToPixel(b.estimate.x(), b.estimate.y()), kEstimate, 2, cv::LINE_AA);
   }
+  // Pick and score attempts: the believed 3-sigma around the estimate, the true position.
+  for (const AttemptCheck& a : r.attempts) {
+    const cv::Scalar colour = a.Inside() ? kAttemptInside : kAttemptOutside;
+    cv::circle(image, canvas.ToPixel(a.estimate_m.x(), a.estimate_m.y()),
+               std::max(2, canvas.ToPixels(a.three_sigma_m)), colour, 2, cv::LINE_AA);
+    cv::drawMarker(image, canvas.ToPixel(a.truth_m.x(), a.truth_m.y()), colour,
+                   a.Inside() ? cv::MARKER_CROSS : cv::MARKER_TILTED_CROSS, 12, 2);
+  }
   double last_t = -1e9;
   for (const PoseSample& s : r.samples) {
     if (s.t_s - last_t < 5.0) continue;
@@ -228,6 +271,8 @@ cv::Mat DrawMatchMap(const MatchResult& r) {
   if (!std::isnan(r.pose_ate_m))
     line("pose ATE " + Fixed(r.pose_ate_m * 100, 1) + " cm over " +
          std::to_string(r.samples.size()) + " updates");
+  if (r.consistency.updates > 0)
+    line("NEES in band or below: " + Fixed(100.0 * r.consistency.HonestFraction(), 0) + " %");
   line("observe " + Fixed(r.observe_s, 1) + " s, drive " + Fixed(r.drive_s, 1) + " s,");
   line("  pick/score " + Fixed(r.score_s, 1) + " s, idle " + Fixed(r.idle_s, 1) + " s");
   y += 12;
@@ -238,6 +283,11 @@ cv::Mat DrawMatchMap(const MatchResult& r) {
   line("  crosses estimates (3-sigma ellipses),");
   line("  black line: error");
   line("landmarks: disc truth, orange + estimate", kEstimate);
+  if (!r.attempts.empty()) {
+    line("picks/scores: + true position, circle 3-sigma,");
+    line("  green: error inside it", kAttemptInside);
+    line("  red x: error outside it", kAttemptOutside);
+  }
   return image;
 }
 
@@ -318,6 +368,15 @@ void PrintSummary(const MatchResult& r, std::ostream& out) {
       << (std::isnan(r.pose_ate_m) ? std::string("unknown") : Fixed(r.pose_ate_m, 4) + " m") << " ("
       << r.samples.size() << " filter updates, " << r.frames_taken << " frames, " << r.replans
       << " replans, " << r.relocalisations << " relocalisations)\n";
+  if (r.consistency.updates > 0) {
+    const PoseConsistency& c = r.consistency;
+    int inside = 0;
+    for (const AttemptCheck& a : r.attempts) inside += a.Inside();
+    out << "  filter honesty  pose NEES in its 95 % band at " << c.in_band << " of " << c.updates
+        << " updates, below (conservative) " << c.below << ", above (overconfident) " << c.above
+        << "; picks/scores with the true error inside 3-sigma: " << inside << " of "
+        << r.attempts.size() << "\n";
+  }
   int matched = 0;
   double sum = 0.0;
   for (const ObjectReport& o : r.objects) {

@@ -56,6 +56,23 @@ TEST(Executive, FullDryRunScoresWithinTheDeadlineAndMapsItsObjects) {
     EXPECT_TRUE(t.contains("t_s"));
     EXPECT_TRUE(t.contains("action"));
   }
+  // The filter against the truth: every update's NEES, every pick/score attempt's error.
+  ASSERT_TRUE(j.contains("nees"));
+  EXPECT_EQ(j["nees"]["updates"].get<int>(), static_cast<int>(r.samples.size()));
+  EXPECT_EQ(j["nees"]["in_band"].get<int>() + j["nees"]["conservative"].get<int>() +
+                j["nees"]["overconfident"].get<int>(),
+            j["nees"]["updates"].get<int>());
+  ASSERT_EQ(j["updates"].size(), r.samples.size());
+  int picks_and_scores = 0;
+  for (const TimelineEntry& t : r.timeline)
+    picks_and_scores += t.action == "PICK" || t.action == "SCORE";
+  ASSERT_EQ(j["attempts"].size(), static_cast<size_t>(picks_and_scores));
+  EXPECT_GT(picks_and_scores, 0);
+  for (const auto& a : j["attempts"]) {
+    EXPECT_EQ(a["inside_three_sigma"].get<bool>(),
+              a["error_m"].get<double>() <= a["three_sigma_m"].get<double>());
+    EXPECT_GT(a["three_sigma_m"].get<double>(), 0.0);
+  }
   WriteTum(r, dir + "/trajectory.tum");
   std::ifstream tum(dir + "/trajectory.tum");
   std::string line;
@@ -64,6 +81,29 @@ TEST(Executive, FullDryRunScoresWithinTheDeadlineAndMapsItsObjects) {
   EXPECT_EQ(poses, r.samples.size());
   EXPECT_GT(std::filesystem::file_size(dir + "/objects.bt"), 0u);
   EXPECT_FALSE(DrawMatchMap(r).empty());
+}
+
+// Where each update's NEES falls against one update's 95 % band [0.22, 9.35] (3 dof).
+TEST(Executive, PoseConsistencyCountsTheBandConservativeAndOverconfident) {
+  const Eigen::Matrix3d covariance = Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal();
+  const auto sample = [&](double sigmas) {
+    PoseSample s;
+    s.truth = Eigen::Vector3d(1.0, 2.0, 0.3);
+    s.estimate = s.truth + Eigen::Vector3d(0.1, 0.1, 0.1) * sigmas;  // NEES 3 sigmas^2
+    s.covariance = covariance;
+    return s;
+  };
+  PoseSample unknown = sample(10.0);
+  unknown.truth_known = false;  // hardware: not counted
+  const PoseConsistency c =
+      PoseConsistencyOf({sample(0.1), sample(1.0), sample(1.5), sample(3.0), unknown});
+  EXPECT_EQ(c.updates, 4);
+  EXPECT_EQ(c.below, 1);    // NEES 0.03: conservative
+  EXPECT_EQ(c.in_band, 2);  // 3 and 6.75
+  EXPECT_EQ(c.above, 1);    // 27: overconfident
+  EXPECT_DOUBLE_EQ(c.HonestFraction(), 0.75);
+  EXPECT_NEAR(c.band_low, 0.216, 1e-3);
+  EXPECT_NEAR(c.band_high, 9.348, 1e-3);
 }
 
 // A strategy that always asks to drive far away, claiming the drive takes `claimed_s`.
