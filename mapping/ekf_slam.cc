@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 
 #include <Eigen/Dense>
 
@@ -58,15 +59,19 @@ double RegularisedGammaP(double a, double x) {
   return 1.0 - std::exp(log_prefix) * h;
 }
 
-// The p-quantile of chi-square with `dof` degrees of freedom, by bisection on its CDF.
+// The p-quantile of chi-square with `dof` degrees of freedom, by bisection on its CDF;
+// remembered, since the adaptive checks ask for the same few at every step.
 double Chi2Quantile(double p, int dof) {
+  thread_local std::map<std::pair<double, int>, double> known;
+  const auto it = known.find({p, dof});
+  if (it != known.end()) return it->second;
   double lo = 0.0, hi = std::max(10.0, 5.0 * dof);
   while (RegularisedGammaP(dof / 2.0, hi / 2.0) < p) hi *= 2.0;
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (lo + hi);
     (RegularisedGammaP(dof / 2.0, mid / 2.0) < p ? lo : hi) = mid;
   }
-  return 0.5 * (lo + hi);
+  return known[{p, dof}] = 0.5 * (lo + hi);
 }
 
 }  // namespace
