@@ -719,7 +719,7 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
       const Eigen::Vector2d release = centre - (reach + 0.01) * dir;
       if (!context.is_clear(stage)) continue;
       if (!platform::FootprintIsFree(others, platform::Pose2D{release.x(), release.y(), heading},
-                                     robot.length_m, robot.width_m)) {
+                                     robot.length_m, robot.width_m, robot.height_m)) {
         continue;
       }
       out.emplace_back(stage.x(), stage.y(), Wrap(heading));
@@ -753,13 +753,13 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
         // round it, not over it).
         if (!platform::FootprintIsFree(*context.season,
                                        platform::Pose2D{release.x(), release.y(), heading},
-                                       robot.length_m, robot.width_m)) {
+                                       robot.length_m, robot.width_m, robot.height_m)) {
           continue;
         }
         bool blocked = false;
         for (double f = 0.0; f <= 1.0 && !blocked; f += 0.05) {
-          blocked =
-              platform::PointInBlockingStructure(*context.season, stage + f * (drop - stage), 0.02);
+          blocked = platform::PointInBlockingStructure(*context.season, stage + f * (drop - stage),
+                                                       0.02, robot.height_m);
         }
         if (!blocked) out.emplace_back(stage.x(), stage.y(), Wrap(heading));
       }
