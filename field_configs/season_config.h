@@ -43,8 +43,9 @@ struct Structure {
   std::string colour;        // a name from SeasonConfig::colours
   bool blocks_robot = true;  // false: the robot drives over or under it (a bump, a tape line)
 
-  // Robots pass under it (blocks_robot false and raised off the floor): a barrier or bar they
-  // drive beneath. Objects taller than z_min_m still cannot pass (see PointBlocksObject).
+  // Robots lower than z_min_m pass under it (blocks_robot false and raised off the floor): a
+  // barrier or bar they drive beneath (see platform::BlocksRobot). Objects taller than z_min_m
+  // cannot pass either (see PointBlocksObject).
   bool PassUnder() const { return !blocks_robot && z_min_m > 0.0; }
 };
 

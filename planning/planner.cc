@@ -153,7 +153,8 @@ Planner::Planner(const field::RobotConfig& robot, const PlannerOptions& options)
 }
 
 void Planner::SetMap(const mapping::ObjectMap& map) {
-  SetGrid(map.ToGrid(options_.grid_cell_m, options_.grid_min_z_m, options_.grid_max_z_m));
+  const double max_z = options_.grid_max_z_m > 0.0 ? options_.grid_max_z_m : robot_.height_m;
+  SetGrid(map.ToGrid(options_.grid_cell_m, options_.grid_min_z_m, max_z));
 }
 
 void Planner::SetMap(const mapping::ObjectMap& map,

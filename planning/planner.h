@@ -15,8 +15,9 @@
 // than sampling at a quarter cell); OMPL checks its motions with it too.
 //
 // Obstacles (the object-obstacle policy): every occupied cell of the grid between
-// grid_min_z_m and grid_max_z_m is an obstacle: walls and structures (drive-over bumps lower
-// than grid_min_z_m are not), every game object in the map's object layer, and whatever the
+// grid_min_z_m and grid_max_z_m (the robot's height by default) is an obstacle: walls and
+// structures (drive-over bumps lower than grid_min_z_m are not, nor raised barriers above the
+// robot's top), every game object in the map's object layer, and whatever the
 // camera put in the map (opponent robots among it). Game objects are obstacles because driving
 // into one pushes it (and the robot off its path), except the target of the current task: the
 // robot drives up to it to take it. SetMap(map, objects, ignore_object_ids) leaves such
@@ -48,7 +49,9 @@ struct PlannerOptions {
   double clearance_m = 0.05;   // margin kept around the footprint, metres
   double grid_cell_m = 0.02;   // cell edge of the planning grid built by SetMap(), metres
   double grid_min_z_m = 0.06;  // lowest height in the grid (above drive-over bumps), metres
-  double grid_max_z_m = 0.50;  // highest height in the grid (about the robot's), metres
+  // Highest height in the grid, metres; 0: the robot's height, so that a raised structure
+  // (a barrier robots pass under) is an obstacle exactly when the robot does not fit under it.
+  double grid_max_z_m = 0.0;
   // Segment checks: 0 for exact (every cell crossed); > 0 to sample every that many metres.
   double check_resolution_m = 0;
   double stop_spacing_m = 0.3;  // observation stops along the path, metres (0: none)

@@ -36,10 +36,14 @@ double DistanceToStructure(const Structure& s, const Eigen::Vector2d& p) {
   return std::hypot(ex, ey);
 }
 
+bool BlocksRobot(const Structure& s, double height_m) {
+  return s.blocks_robot || (s.PassUnder() && height_m >= s.z_min_m);
+}
+
 bool PointInBlockingStructure(const SeasonConfig& season, const Eigen::Vector2d& p,
-                              double clearance_m) {
+                              double clearance_m, double height_m) {
   for (const Structure& s : season.structures) {
-    if (s.blocks_robot && DistanceToStructure(s, p) <= clearance_m) return true;
+    if (BlocksRobot(s, height_m) && DistanceToStructure(s, p) <= clearance_m) return true;
   }
   return false;
 }
@@ -72,7 +76,7 @@ bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p) {
 }
 
 bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double length_m,
-                     double width_m) {
+                     double width_m, double height_m) {
   const double c = std::cos(pose.theta_rad);
   const double s = std::sin(pose.theta_rad);
   // Sample the footprint's outline and centre line densely enough for the thinnest posts.
@@ -88,7 +92,7 @@ bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double leng
       const Eigen::Vector2d p(pose.x_m + c * lx - s * ly, pose.y_m + s * lx + c * ly);
       if (std::abs(p.x()) > half || std::abs(p.y()) > half) return false;
       for (const Structure& st : season.structures) {
-        if (st.blocks_robot && DistanceToStructure(st, p) <= 0.0) return false;
+        if (BlocksRobot(st, height_m) && DistanceToStructure(st, p) <= 0.0) return false;
       }
     }
   }

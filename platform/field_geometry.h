@@ -15,14 +15,18 @@ namespace slamo::platform {
 // Distance from point p to a structure's footprint in the plane (0 inside).
 double DistanceToStructure(const field::Structure& s, const Eigen::Vector2d& p);
 
-// True when a rectangle footprint at `pose` (length along the heading) is inside the
-// perimeter and clear of every structure that blocks robots.
-bool FootprintIsFree(const field::SeasonConfig& season, const Pose2D& pose, double length_m,
-                     double width_m);
+// True when a robot `height_m` tall cannot be where structure s stands: s blocks robots, or
+// it is raised (a barrier robots pass under) and its underside is not above the robot's top.
+bool BlocksRobot(const field::Structure& s, double height_m);
 
-// True when the point lies on a structure that blocks robots (and objects).
+// True when a rectangle footprint at `pose` (length along the heading) of a robot `height_m`
+// tall is inside the perimeter and clear of every structure that blocks it (BlocksRobot).
+bool FootprintIsFree(const field::SeasonConfig& season, const Pose2D& pose, double length_m,
+                     double width_m, double height_m);
+
+// True when the point lies on a structure that blocks a robot `height_m` tall (BlocksRobot).
 bool PointInBlockingStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p,
-                              double clearance_m);
+                              double clearance_m, double height_m);
 
 // True when an object (footprint radius, height) centred at p would overlap a structure it
 // cannot pass: one that blocks robots, or a raised one (a barrier robots pass under) whose

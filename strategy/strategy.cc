@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
@@ -45,6 +46,9 @@ struct Cycle {
   double gain = 0.0;         // points after - points before
   double probability = 0.0;  // of the pick and the release both succeeding
   int frames = 0;            // observed first
+  // A knock: drive to pick_stage, then push straight on to score_stage; the object drops into
+  // goal (a zone). Nothing is held before or after.
+  bool knock = false;
   double Value() const { return probability * gain; }
 };
 
@@ -55,6 +59,8 @@ class Base : public Strategy {
   explicit Base(const StrategyOptions& options) : options_(options) {}
 
   void Feedback(const Action& action, bool succeeded) override {
+    // A push is not repeated: the object either came down or is not where it was believed.
+    if (action.kind == ActionKind::kNavigate && action.push) knocked_.insert(action.object_id);
     if (succeeded) return;
     if (action.kind == ActionKind::kPick && action.object_id >= 0)
       ++failed_objects_[action.object_id];
@@ -167,11 +173,102 @@ class Base : public Strategy {
     return failed == failed_objects_.end() || failed->second < 2;
   }
 
-  // Cycles for one object from `from`: pick it, then each goal that takes it.
+  // The raised structure (one robots pass under) an object lies on: an object that does not fit
+  // under it and whose centre is within its radius of the structure cannot stand on the floor
+  // there, so it is on top (a large ball on the Toss Up barrier). nullptr for the others.
+  static const field::Structure* RaisedOn(const field::SeasonConfig& season,
+                                          const std::string& kind, const Eigen::Vector2d& p) {
+    const field::ObjectType* type = season.FindObjectType(kind);
+    if (!type) return nullptr;
+    for (const field::Structure& s : season.structures) {
+      if (s.PassUnder() && type->height_m > s.z_min_m &&
+          platform::DistanceToStructure(s, p) < type->size_m / 2.0) {
+        return &s;
+      }
+    }
+    return nullptr;
+  }
+
+  // Knocking an object off the raised structure it lies on: for each way across the structure
+  // (a box's thin axis), the robot drives straight at it and stops where it can still turn in
+  // place (pressed against the structure it could not turn away); its bumper has pushed the
+  // object on by its radius, and the object drops where it then stands.
+  std::vector<Cycle> KnockCycles(const Belief& b, const StrategyContext& c, const ObjectBelief& o,
+                                 const field::Structure& s, const Eigen::Vector3d& from,
+                                 int frames) const {
+    std::vector<Cycle> out;
+    if (knocked_.count(o.id) || s.shape != field::SolidShape::kBox) return out;
+    const double r = ObjectRadius(*c.season, o.kind);
+    const double yaw = s.yaw_deg * kPi / 180.0 + (s.size_m.x <= s.size_m.y ? 0.0 : kPi / 2.0);
+    const double half = c.season->HalfSize();
+    for (const double sign : {1.0, -1.0}) {
+      const Eigen::Vector2d dir = sign * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+      const double turn_radius = std::hypot(c.robot->length_m, c.robot->width_m) / 2.0 + 0.02;
+      std::optional<Eigen::Vector2d> end;
+      for (double back = 0.0; back <= 1.0 && !end; back += 0.02) {
+        const Eigen::Vector2d p = o.position_m - back * dir;
+        if (c.is_clear(p) && std::abs(p.x()) < half - turn_radius &&
+            std::abs(p.y()) < half - turn_radius &&
+            !platform::PointInBlockingStructure(*c.season, p, turn_radius, c.robot->height_m)) {
+          end = p;
+        }
+      }
+      if (!end) continue;
+      const Eigen::Vector2d front = *end + dir * (c.robot->length_m / 2.0);
+      if ((front - o.position_m).dot(dir) < -r) continue;  // the bumper would not reach it
+      Eigen::Vector2d land = front + dir * (r + 0.01);
+      if (platform::DistanceToStructure(s, land) <= 0.0) continue;  // still on top
+      // Off the top, it rolls on over the edge to rest on the floor clear of the structure.
+      const double height = c.season->FindObjectType(o.kind)->height_m;
+      for (int k = 0; k < 50 && platform::PointBlocksObject(*c.season, land, r, height); ++k)
+        land += 0.01 * dir;
+      if (std::abs(land.x()) > half - r || std::abs(land.y()) > half - r) continue;
+      int goal = -1, points = 0;
+      for (int g = 0; g < static_cast<int>(c.season->goals.size()); ++g) {
+        if (c.season->goals[g].kind != field::GoalKind::kZone) continue;
+        if (!platform::GoalContains(c.season->goals[g], land)) continue;
+        const int p = GoalPoints(*c.season, g, o.kind, o.colour, c.alliance);
+        if (p > points) goal = g, points = p;
+      }
+      if (goal < 0) continue;
+      const double heading = std::atan2(dir.y(), dir.x());
+      const Eigen::Vector2d stage = *end - options_.push_run_in_m * dir;
+      if (!c.is_clear(stage)) continue;
+      const Eigen::Vector3d stage_pose(stage.x(), stage.y(), heading);
+      if (failed_targets_.count(Key(stage_pose))) continue;
+      const std::optional<double> t = c.travel_time_s(from, stage_pose);
+      if (!t) continue;
+      Cycle cycle;
+      cycle.object = &o;
+      cycle.knock = true;
+      cycle.pick_stage = stage_pose;
+      cycle.score_stage = Eigen::Vector3d(end->x(), end->y(), heading);
+      cycle.goal = goal;
+      cycle.seconds = *t + PushSeconds(c) + frames / c.frame_rate_hz;
+      cycle.gain = points;  // on top of a structure it lies in no zone
+      // Straight off when the bumper meets it within half its width of its centre.
+      const double pose_var = PoseVarianceAfter(b, frames);
+      const Eigen::Matrix2d cov =
+          o.covariance + Eigen::Matrix2d::Identity() * (pose_var + b.pose_covariance(2, 2) * 0.25);
+      cycle.probability = SuccessProbability(cov, c.robot->width_m / 2.0) * o.confidence;
+      cycle.frames = frames;
+      out.push_back(cycle);
+    }
+    return out;
+  }
+
+  double PushSeconds(const StrategyContext& c) const {
+    return options_.push_run_in_m / c.robot->drive.cruise_speed_mps + 0.5;
+  }
+
+  // Cycles for one object from `from`: pick it, then each goal that takes it; or knock it off
+  // the raised structure it lies on.
   std::vector<Cycle> ObjectCycles(const Belief& b, const StrategyContext& c, const ObjectBelief& o,
                                   const Eigen::Vector3d& from, int frames) const {
     std::vector<Cycle> out;
     if (!Scores(c, o)) return out;
+    if (const field::Structure* raised = RaisedOn(*c.season, o.kind, o.position_m))
+      return KnockCycles(b, c, o, *raised, from, frames);
     const double r = ObjectRadius(*c.season, o.kind);
     const std::optional<Eigen::Vector3d> stage =
         PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m);
@@ -231,6 +328,24 @@ class Base : public Strategy {
     const Eigen::Vector3d stage = cycle.object ? cycle.pick_stage : cycle.score_stage;
     // Near enough: the pick and the release turn to their target and drive the rest.
     const bool at_stage = (b.pose.head<2>() - stage.head<2>()).norm() < kAtStage_m;
+    if (cycle.knock) {
+      a.kind = ActionKind::kNavigate;
+      a.object_id = cycle.object->id;
+      a.goal_index = cycle.goal;
+      const std::string what =
+          cycle.object->colour + " " + cycle.object->kind + " #" + std::to_string(cycle.object->id);
+      if (!at_stage) {
+        a.target = stage;
+        a.expected_s = c.travel_time_s(b.pose, stage).value_or(0.0);
+        a.why = "to knock " + what + " off";
+      } else {
+        a.push = true;
+        a.target = cycle.score_stage;
+        a.expected_s = PushSeconds(c);
+        a.why = "knock " + what + " into " + c.season->goals[cycle.goal].name;
+      }
+      return a;
+    }
     if (!at_stage) {
       a.kind = ActionKind::kNavigate;
       a.target = stage;
@@ -355,6 +470,7 @@ class Base : public Strategy {
   std::map<int, int> failed_goals_;
   std::map<long, int> failed_targets_;
   std::map<long, int> looked_;
+  std::set<int> knocked_;
   bool surveyed_ = false;
 };
 
@@ -494,7 +610,11 @@ class GreedyStrategy : public Base {
 };
 
 // A fixed route from the season's nominal positions, planned once before the match, driven
-// blind: what a team's scripted autonomous does.
+// blind: what a team's scripted autonomous does. A team authors the route that scores most in
+// the period on the field as drawn; here that is a beam search over sequences of cycles (the
+// preload's release, picks and releases, knocks off raised structures), each timed with the
+// planner's travel times like every strategy's, keeping the sequence with the most points that
+// finishes by the deadline.
 class ScriptedStrategy : public Base {
  public:
   using Base::Base;
@@ -512,97 +632,144 @@ class ScriptedStrategy : public Base {
   }
 
  private:
+  static constexpr int kBeamWidth = 24;
+
+  // A route in the making: its cycles (with the nominal object each takes, -1 for the held
+  // object), where it leaves the robot, and its points and seconds so far.
+  struct Partial {
+    std::vector<std::pair<Cycle, int>> cycles;
+    Eigen::Vector3d pose = Eigen::Vector3d::Zero();
+    std::optional<ObjectBelief> held;
+    std::vector<bool> used;
+    double t = 0.0;
+    double points = 0.0;
+  };
+
   void Plan(const Belief& b, const StrategyContext& c) {
     planned_ = true;
     // The nominal objects: fixed positions from the season file (regions are unknown).
-    std::vector<ObjectBelief> nominal;
+    nominal_.clear();
     int id = -1;
     for (const field::ObjectPlacement& p : c.season->objects) {
-      if (!p.position_m || p.z_m > 0.0) continue;
+      if (!p.position_m) continue;
+      const Eigen::Vector2d at(p.position_m->x, p.position_m->y);
+      // Raised: knocked off a structure; stacked on other objects: left alone.
+      if (p.z_m > 0.0 && !RaisedOn(*c.season, p.type, at)) continue;
       ObjectBelief o;
       o.id = id--;
       o.kind = p.type;
       o.colour = p.colour;
-      o.position_m = Eigen::Vector2d(p.position_m->x, p.position_m->y);
+      o.position_m = at;
       o.covariance = Eigen::Matrix2d::Identity() * 1e-6;
       if ((o.position_m - b.pose.head<2>()).norm() < 0.3) continue;  // the preload
-      nominal.push_back(o);
+      nominal_.push_back(o);
     }
-    Belief plan = b;
-    plan.objects.clear();
-    double t = b.now_s;
-    bool held = b.held.has_value();
-    std::optional<ObjectBelief> held_object = b.held;
-    std::vector<bool> used(nominal.size(), false);
-    for (int cycle_index = 0; cycle_index < 4; ++cycle_index) {
-      std::optional<Cycle> chosen;
-      size_t chosen_index = 0;
-      if (held) {
-        plan.held = held_object;
-        for (const Cycle& cycle : HeldCycles(plan, c, 0)) {
-          if (!chosen || cycle.gain / cycle.seconds > chosen->gain / chosen->seconds)
-            chosen = cycle;
+    Partial root;
+    root.pose = b.pose;
+    root.held = b.held;
+    root.used.assign(nominal_.size(), false);
+    root.t = b.now_s;
+    Partial best = root;
+    const auto better = [](const Partial& x, const Partial& y) {
+      return x.points > y.points + 1e-9 || (std::abs(x.points - y.points) <= 1e-9 && x.t < y.t);
+    };
+    std::vector<Partial> beam = {root};
+    while (!beam.empty()) {
+      std::vector<Partial> next;
+      for (const Partial& p : beam) {
+        Belief plan = b;
+        plan.objects.clear();
+        plan.pose = p.pose;
+        plan.held = p.held;
+        const auto extend = [&](const Cycle& cycle, int index) {
+          if (cycle.gain <= 0 || p.t + cycle.seconds > b.deadline_s) return;
+          Partial child = p;
+          child.cycles.emplace_back(cycle, index);
+          child.t += cycle.seconds;
+          child.points += cycle.gain;
+          child.held.reset();
+          if (index >= 0) child.used[index] = true;
+          child.pose = cycle.score_stage;
+          next.push_back(child);
+        };
+        if (p.held) {
+          for (const Cycle& cycle : HeldCycles(plan, c, 0)) extend(cycle, -1);
+          continue;
         }
-      } else {
-        for (size_t i = 0; i < nominal.size(); ++i) {
-          if (used[i]) continue;
-          for (const Cycle& cycle : ObjectCycles(plan, c, nominal[i], plan.pose, 0)) {
-            if (cycle.gain <= 0) continue;
-            if (!chosen || cycle.gain / cycle.seconds > chosen->gain / chosen->seconds) {
-              chosen = cycle, chosen_index = i;
-            }
-          }
+        for (size_t i = 0; i < nominal_.size(); ++i) {
+          if (p.used[i]) continue;
+          for (const Cycle& cycle : ObjectCycles(plan, c, nominal_[i], p.pose, 0))
+            extend(cycle, static_cast<int>(i));
         }
       }
-      if (!chosen || t + chosen->seconds > b.deadline_s) break;
-      Action nav;
-      nav.kind = ActionKind::kNavigate;
-      if (!held) {
-        nav.target = chosen->pick_stage;
-        nav.expected_s = c.travel_time_s(plan.pose, nav.target).value_or(0.0);
-        nav.object_id = nominal[chosen_index].id;
-        nav.why =
-            "script: to nominal " + nominal[chosen_index].colour + " " + nominal[chosen_index].kind;
-        route_.push_back(nav);
-        Action pick;
-        pick.kind = ActionKind::kPick;
-        pick.object_id = nominal[chosen_index].id;
-        pick.target = Eigen::Vector3d(nominal[chosen_index].position_m.x(),
-                                      nominal[chosen_index].position_m.y(), chosen->pick_stage.z());
-        pick.expected_s = ApproachSeconds(c) + options_.pick_s;
-        pick.why = "script: pick";
-        route_.push_back(pick);
-        used[chosen_index] = true;
-        held_object = nominal[chosen_index];
-        const double r = ObjectRadius(*c.season, nominal[chosen_index].kind);
-        const Eigen::Vector2d dir(std::cos(chosen->pick_stage.z()),
-                                  std::sin(chosen->pick_stage.z()));
-        plan.pose = Eigen::Vector3d(
-            nominal[chosen_index].position_m.x() - dir.x() * PickDistance(*c.robot, r),
-            nominal[chosen_index].position_m.y() - dir.y() * PickDistance(*c.robot, r),
-            chosen->pick_stage.z());
-      }
-      nav.target = chosen->score_stage;
-      nav.object_id = -1;
-      nav.goal_index = chosen->goal;
-      nav.expected_s = c.travel_time_s(plan.pose, nav.target).value_or(0.0);
-      nav.why = "script: to " + c.season->goals[chosen->goal].name;
-      route_.push_back(nav);
-      Action score;
-      score.kind = ActionKind::kScore;
-      score.goal_index = chosen->goal;
-      score.target = chosen->score_stage;
-      score.expected_s = ApproachSeconds(c) + options_.release_s;
-      score.why = "script: release";
-      route_.push_back(score);
-      plan.pose = chosen->score_stage;
-      t += chosen->seconds;
-      held = false;
-      held_object.reset();
-      plan.held.reset();
+      std::sort(next.begin(), next.end(), better);
+      if (next.size() > kBeamWidth) next.resize(kBeamWidth);
+      if (!next.empty() && better(next.front(), best)) best = next.front();
+      beam = std::move(next);
+    }
+    Eigen::Vector3d from = b.pose;
+    for (const auto& [cycle, index] : best.cycles) {
+      Emit(c, cycle, index, from);
+      from = cycle.score_stage;
     }
   }
 
+  // The actions of one planned cycle, starting from `from`.
+  void Emit(const StrategyContext& c, const Cycle& cycle, int index, const Eigen::Vector3d& from) {
+    Action nav;
+    nav.kind = ActionKind::kNavigate;
+    Eigen::Vector3d at = from;
+    if (index >= 0) nav.expected_s = c.travel_time_s(from, cycle.pick_stage).value_or(0.0);
+    if (cycle.knock) {
+      const ObjectBelief& o = nominal_[index];
+      nav.target = cycle.pick_stage;
+      nav.object_id = o.id;
+      nav.why = "script: to knock nominal " + o.colour + " " + o.kind + " off";
+      route_.push_back(nav);
+      Action push = nav;
+      push.push = true;
+      push.target = cycle.score_stage;
+      push.goal_index = cycle.goal;
+      push.expected_s = PushSeconds(c);
+      push.why = "script: knock it into " + c.season->goals[cycle.goal].name;
+      route_.push_back(push);
+      return;
+    }
+    if (index >= 0) {
+      const ObjectBelief& o = nominal_[index];
+      nav.target = cycle.pick_stage;
+      nav.object_id = o.id;
+      nav.why = "script: to nominal " + o.colour + " " + o.kind;
+      route_.push_back(nav);
+      Action pick;
+      pick.kind = ActionKind::kPick;
+      pick.object_id = o.id;
+      pick.target = Eigen::Vector3d(o.position_m.x(), o.position_m.y(), cycle.pick_stage.z());
+      pick.expected_s = ApproachSeconds(c) + options_.pick_s;
+      pick.why = "script: pick";
+      route_.push_back(pick);
+      const double r = ObjectRadius(*c.season, o.kind);
+      const Eigen::Vector2d dir(std::cos(cycle.pick_stage.z()), std::sin(cycle.pick_stage.z()));
+      at = Eigen::Vector3d(o.position_m.x() - dir.x() * PickDistance(*c.robot, r),
+                           o.position_m.y() - dir.y() * PickDistance(*c.robot, r),
+                           cycle.pick_stage.z());
+    }
+    nav.expected_s = c.travel_time_s(at, cycle.score_stage).value_or(0.0);
+    nav.target = cycle.score_stage;
+    nav.object_id = -1;
+    nav.goal_index = cycle.goal;
+    nav.why = "script: to " + c.season->goals[cycle.goal].name;
+    route_.push_back(nav);
+    Action score;
+    score.kind = ActionKind::kScore;
+    score.goal_index = cycle.goal;
+    score.target = cycle.score_stage;
+    score.expected_s = ApproachSeconds(c) + options_.release_s;
+    score.why = "script: release";
+    route_.push_back(score);
+  }
+
+  std::vector<ObjectBelief> nominal_;
   bool planned_ = false;
   std::vector<Action> route_;
   size_t next_ = 0;
@@ -719,7 +886,7 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
       const Eigen::Vector2d release = centre - (reach + 0.01) * dir;
       if (!context.is_clear(stage)) continue;
       if (!platform::FootprintIsFree(others, platform::Pose2D{release.x(), release.y(), heading},
-                                     robot.length_m, robot.width_m)) {
+                                     robot.length_m, robot.width_m, robot.height_m)) {
         continue;
       }
       out.emplace_back(stage.x(), stage.y(), Wrap(heading));
@@ -753,13 +920,13 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
         // round it, not over it).
         if (!platform::FootprintIsFree(*context.season,
                                        platform::Pose2D{release.x(), release.y(), heading},
-                                       robot.length_m, robot.width_m)) {
+                                       robot.length_m, robot.width_m, robot.height_m)) {
           continue;
         }
         bool blocked = false;
         for (double f = 0.0; f <= 1.0 && !blocked; f += 0.05) {
-          blocked =
-              platform::PointInBlockingStructure(*context.season, stage + f * (drop - stage), 0.02);
+          blocked = platform::PointInBlockingStructure(*context.season, stage + f * (drop - stage),
+                                                       0.02, robot.height_m);
         }
         if (!blocked) out.emplace_back(stage.x(), stage.y(), Wrap(heading));
       }

@@ -21,6 +21,11 @@
 // worth anything (nothing known), it turns to look where the season says objects of our
 // colour may be and nothing is tracked yet.
 //
+// An object lying on top of a raised structure (a large ball on the Toss Up barrier, which it
+// does not fit under) cannot be picked: every strategy may instead knock it off, driving
+// straight into it across the structure so that it drops into the zone beyond (a "push"
+// navigation), valued like a cycle by the points of the zone it lands in.
+//
 // Baselines: "greedy" (nearest known object of ours, the best goal for it, no search), "thesis"
 // (greedy targets, driven with a stop every 0.3 m and 20 frames at each, as the thesis did),
 // and "scripted" (a fixed route from the season's nominal positions, no perception: what teams
@@ -73,8 +78,11 @@ struct Action {
   bool look_heading = false;
   Eigen::Vector3d target = Eigen::Vector3d::Zero();  // x_m, y_m, heading_rad
   double stop_spacing_m = 0.0;                       // kNavigate: observation stops (0: none)
-  int object_id = -1;                                // kPick
-  int goal_index = -1;                               // kScore: into SeasonConfig::goals
+  // kNavigate: a push, driven straight into object_id to knock it off the raised structure it
+  // lies on (a large ball off the Toss Up barrier) into the zone beyond.
+  bool push = false;
+  int object_id = -1;            // kPick
+  int goal_index = -1;           // kScore: into SeasonConfig::goals
   double expected_s = 0.0;       // the strategy's estimate of the action's duration
   double expected_points = 0.0;  // expected points of the sequence this action starts
   std::string why;               // one line for the timeline
@@ -86,6 +94,7 @@ struct StrategyOptions {
   double pick_s = 1.0;              // intake time, seconds
   double release_s = 1.0;           // release time, seconds
   double approach_margin_m = 0.15;  // staging pose this far before the final straight approach
+  double push_run_in_m = 0.35;      // knock: straight run-in to the object on a raised structure
   double pick_tolerance_m = 0.12;   // lateral error the intake forgives
   std::vector<int> frame_choices = {0, 5, 10, 20};
   // Pose information one frame of landmarks adds, as position sigmas (m): white per frame,

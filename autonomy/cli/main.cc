@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
       "  slamo dry-run                             a simulated autonomous period: report, map, "
       "replay\n"
       "  slamo tune --matches 50 --param strategy=planner,greedy --jobs 2   ranked over seeds\n"
-      "  slamo plan --no-objects --from -1.524,0.3048,0 --to 0.3,-1.2,90 --out plan.png   a path\n"
+      "  slamo plan --no-objects --from -0.8955,1.40,0 --to 0.3,-1.2,90 --out plan.png   a path\n"
       "  slamo record --sim --script \"forward 0.3; turn 90\" --out run   TUM folder + rawlog\n"
       "  slamo match --port /dev/ttyACM0           the match-day run on the robot\n"
       "  slamo match --fake-board --camera sim     the same on the fake board, no robot");

@@ -197,7 +197,7 @@ void RegisterPlanCommand(CLI::App& app, CommandAction* action) {
   CLI::App* plan = app.add_subcommand(
       "plan",
       "Plan a path across the field with its starting objects; print length, time and stops.   "
-      "e.g. slamo plan --no-objects --from -1.524,0.3048,0 --to 0.3,-1.2,90 --out plan.png");
+      "e.g. slamo plan --no-objects --from -0.8955,1.40,0 --to 0.3,-1.2,90 --out plan.png");
   AddSeasonRobotOptions(plan, &args->season, &args->robot);
   plan->add_option("--from", args->from, "start pose X,Y,TH_DEG (metres, degrees)")->required();
   plan->add_option("--to", args->to, "goal pose X,Y,TH_DEG (metres, degrees)")->required();

@@ -124,7 +124,7 @@ int RecordSim(const RecordArgs& args) {
   const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
   const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
   const Pose2D start = PoseOrFirstStart(season, args.pose);
-  if (!platform::FootprintIsFree(season, start, robot.length_m, robot.width_m)) {
+  if (!platform::FootprintIsFree(season, start, robot.length_m, robot.width_m, robot.height_m)) {
     std::cerr << "error: --pose " << args.pose
               << ": the robot does not fit there (wall or structure)\n";
     return 2;

@@ -33,7 +33,8 @@ Pose2D RandomView(const field::SeasonConfig& season, const field::RobotConfig& r
     if (distance < 0.8 || distance > 3.5) continue;
     Pose2D pose = candidate;
     pose.theta_rad = std::atan2(dy, dx) + (unit(*rng) - 0.5) * 0.8;
-    if (platform::FootprintIsFree(season, pose, robot.length_m, robot.width_m)) return pose;
+    if (platform::FootprintIsFree(season, pose, robot.length_m, robot.width_m, robot.height_m))
+      return pose;
   }
   return Pose2D{-1.5, 0.0, 0.0};
 }

@@ -17,6 +17,41 @@ bool OnFloor(const SimObject& o) {
   return !o.held && o.in_goal < 0 && o.center_m.z() - o.type->height_m / 2.0 < 0.05;
 }
 
+// Whether an object rests on a structure's top (a ball on a raised barrier): it lies in no
+// floor zone until it comes down.
+bool OnStructure(const field::SeasonConfig& season, const SimObject& o) {
+  const double bottom = o.center_m.z() - o.type->height_m / 2.0;
+  if (o.held || o.in_goal >= 0 || bottom < 1e-3) return false;
+  for (const field::Structure& s : season.structures) {
+    if (std::abs(s.height_m - bottom) < 0.01 && DistanceToStructure(s, o.center_m.head<2>()) <= 0.0)
+      return true;
+  }
+  return false;
+}
+
+// Whether a pusher `height_m` tall moves the object: one on the floor, or one resting on a
+// structure's top lower than the pusher's (a robot knocking a ball off a raised barrier).
+bool Pushable(const field::SeasonConfig& season, const SimObject& o, double height_m) {
+  if (OnFloor(o)) return true;
+  return OnStructure(season, o) && o.center_m.z() - o.type->height_m / 2.0 < height_m;
+}
+
+// Whether object o cannot be centred at p at its present height: on the floor, a structure it
+// does not fit under (PointBlocksObject); raised, a structure reaching above its bottom (a
+// ball on a barrier rolls over the barrier's top, not through a goal post).
+bool ObjectBlockedAt(const field::SeasonConfig& season, const SimObject& o, const Vector2d& p) {
+  const double r = o.type->size_m / 2.0;
+  const double bottom = o.center_m.z() - o.type->height_m / 2.0;
+  if (bottom < 0.05) return PointBlocksObject(season, p, r, o.type->height_m);
+  for (const field::Structure& s : season.structures) {
+    if (s.height_m > bottom + 1e-3 && s.z_min_m < bottom + o.type->height_m &&
+        DistanceToStructure(s, p) <= r) {
+      return true;
+    }
+  }
+  return false;
+}
+
 // Oriented rectangles overlap (separating axis test).
 bool RectanglesOverlap(const Pose2D& a, double al, double aw, const Pose2D& b, double bl,
                        double bw) {
@@ -50,12 +85,12 @@ SimField::SimField(const field::SeasonConfig& season, const field::RobotConfig& 
   drive_.SetFreeSpaceCheck([this](const Pose2D& pose) { return RobotPoseIsFree(pose); });
   if (options_.preload) Preload();
   // An object under the robot at the start is pushed clear of it.
-  PushOut(start, robot_.length_m, robot_.width_m);
+  PushOut(start, robot_.length_m, robot_.width_m, robot_.height_m);
 }
 
 void SimField::Step(double dt_s) {
   drive_.Step(dt_s);
-  PushOut(drive_.true_pose(), robot_.length_m, robot_.width_m);
+  PushOut(drive_.true_pose(), robot_.length_m, robot_.width_m, robot_.height_m);
   for (size_t i = 0; i < world_.opponents.size(); ++i) StepOpponent(i, dt_s);
   Settle();
   time_s_ += dt_s;
@@ -94,20 +129,22 @@ void SimField::Settle() {
 }
 
 bool SimField::RobotPoseIsFree(const Pose2D& pose) const {
-  if (!FootprintIsFree(season_, pose, robot_.length_m, robot_.width_m)) return false;
+  if (!FootprintIsFree(season_, pose, robot_.length_m, robot_.width_m, robot_.height_m))
+    return false;
   for (const SimOpponent& o : world_.opponents) {
     if (RectanglesOverlap(pose, robot_.length_m, robot_.width_m, o.pose, o.config.size_m.x,
                           o.config.size_m.y)) {
       return false;
     }
   }
-  return CanPushOut(pose, robot_.length_m, robot_.width_m);
+  return CanPushOut(pose, robot_.length_m, robot_.width_m, robot_.height_m);
 }
 
 bool SimField::OpponentPoseIsFree(size_t index, const Pose2D& pose) const {
   const SimOpponent& me = world_.opponents[index];
   const double l = me.config.size_m.x, w = me.config.size_m.y;
-  if (!FootprintIsFree(season_, pose, l, w)) return false;
+  // Opponents' heights are not configured: they do not pass under raised structures.
+  if (!FootprintIsFree(season_, pose, l, w, std::numeric_limits<double>::infinity())) return false;
   if (RectanglesOverlap(pose, l, w, drive_.true_pose(), robot_.length_m, robot_.width_m)) {
     return false;
   }
@@ -118,7 +155,7 @@ bool SimField::OpponentPoseIsFree(size_t index, const Pose2D& pose) const {
       return false;
     }
   }
-  return CanPushOut(pose, l, w);
+  return CanPushOut(pose, l, w, std::numeric_limits<double>::infinity());
 }
 
 std::optional<Vector2d> SimField::PushedPosition(const SimObject& object, const Pose2D& pose,
@@ -147,10 +184,22 @@ std::optional<Vector2d> SimField::PushedPosition(const SimObject& object, const 
   }
   const double limit = season_.HalfSize() - r;
   const auto valid = [&](const Vector2d& in_robot) -> std::optional<Vector2d> {
-    const Vector2d world(pose.x_m + c * in_robot.x() - s * in_robot.y(),
-                         pose.y_m + s * in_robot.x() + c * in_robot.y());
+    Vector2d world(pose.x_m + c * in_robot.x() - s * in_robot.y(),
+                   pose.y_m + s * in_robot.x() + c * in_robot.y());
     if (std::abs(world.x()) > limit || std::abs(world.y()) > limit) return std::nullopt;
-    if (PointBlocksObject(season_, world, r, object.type->height_m)) return std::nullopt;
+    if (ObjectBlockedAt(season_, object, world)) return std::nullopt;
+    if (OnStructure(season_, object)) {
+      // Pushed off the structure's top, it rolls on over the edge and comes to rest on the
+      // floor clear of the structure.
+      SimObject moved = object;
+      moved.center_m.head<2>() = world;
+      const Vector2d away = (world - object.center_m.head<2>()).normalized();
+      if (!OnStructure(season_, moved) && away.allFinite()) {
+        for (int k = 0; k < 50 && PointBlocksObject(season_, world, r, object.type->height_m); ++k)
+          world += 0.01 * away;
+        if (std::abs(world.x()) > limit || std::abs(world.y()) > limit) return std::nullopt;
+      }
+    }
     return world;
   };
   if (const auto world = valid(pushed)) return world;
@@ -165,16 +214,17 @@ std::optional<Vector2d> SimField::PushedPosition(const SimObject& object, const 
   return std::nullopt;
 }
 
-bool SimField::CanPushOut(const Pose2D& pose, double length_m, double width_m) const {
+bool SimField::CanPushOut(const Pose2D& pose, double length_m, double width_m,
+                          double height_m) const {
   for (const SimObject& o : world_.objects) {
-    if (OnFloor(o) && !PushedPosition(o, pose, length_m, width_m)) return false;
+    if (Pushable(season_, o, height_m) && !PushedPosition(o, pose, length_m, width_m)) return false;
   }
   return true;
 }
 
-void SimField::PushOut(const Pose2D& pose, double length_m, double width_m) {
+void SimField::PushOut(const Pose2D& pose, double length_m, double width_m, double height_m) {
   for (SimObject& o : world_.objects) {
-    if (!OnFloor(o)) continue;
+    if (!Pushable(season_, o, height_m)) continue;
     if (const auto p = PushedPosition(o, pose, length_m, width_m)) o.center_m.head<2>() = *p;
   }
 }
@@ -195,7 +245,7 @@ void SimField::StepOpponent(size_t index, double dt_s) {
   next.y_m = moved.y();
   if (!OpponentPoseIsFree(index, next)) return;  // blocked: wait
   o.pose = next;
-  PushOut(o.pose, o.config.size_m.x, o.config.size_m.y);
+  PushOut(o.pose, o.config.size_m.x, o.config.size_m.y, std::numeric_limits<double>::infinity());
   if (arrives) {
     ++o.next_waypoint;
     if (o.next_waypoint >= path.size() && o.config.loop) o.next_waypoint = 0;
@@ -299,7 +349,8 @@ int SimField::ObjectPoints(const SimObject& object, field::Alliance alliance) co
     if (goal.alliance != field::Alliance::kNone && goal.alliance != alliance) continue;
     const bool inside = goal.kind == field::GoalKind::kGoal
                             ? object.in_goal == static_cast<int>(g)
-                            : object.in_goal < 0 && GoalContains(goal, object.center_m.head<2>());
+                            : object.in_goal < 0 && !OnStructure(season_, object) &&
+                                  GoalContains(goal, object.center_m.head<2>());
     if (!inside) continue;
     const auto it = goal.points.find(object.type->name);
     if (it != goal.points.end()) best = std::max(best, it->second);

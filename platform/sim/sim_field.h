@@ -70,10 +70,11 @@ class SimField {
  private:
   bool RobotPoseIsFree(const Pose2D& pose) const;
   bool OpponentPoseIsFree(size_t index, const Pose2D& pose) const;
-  // Moves the objects overlapping a rectangle out of it; false (and nothing moved) when one
-  // cannot go anywhere free.
-  bool CanPushOut(const Pose2D& pose, double length_m, double width_m) const;
-  void PushOut(const Pose2D& pose, double length_m, double width_m);
+  // Moves the objects overlapping a rectangle `height_m` tall out of it: those on the floor,
+  // and those resting on a structure's top below height_m (a ball knocked off a raised
+  // barrier, which then drops); false (and nothing moved) when one cannot go anywhere free.
+  bool CanPushOut(const Pose2D& pose, double length_m, double width_m, double height_m) const;
+  void PushOut(const Pose2D& pose, double length_m, double width_m, double height_m);
   // Objects whose support went (the object below a stack picked or pushed away) drop onto
   // what is now under them: another object, a structure's top, or the floor.
   void Settle();

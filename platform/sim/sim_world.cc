@@ -11,7 +11,6 @@ namespace slamo::platform {
 namespace {
 
 using field::SeasonConfig;
-using field::Structure;
 
 double ObjectHeight(const field::ObjectType& type) { return type.height_m; }
 
@@ -34,7 +33,7 @@ SimWorld CreateWorld(const SeasonConfig& season, uint64_t seed) {
   const double warm = 0.06 * (unit(rng) - 0.5);
   world.lighting.tint = Eigen::Vector3d(1.0 + warm, 1.0, 1.0 - warm);
 
-  const auto clear_of_everything = [&](const Eigen::Vector3d& c, double radius) {
+  const auto clear_of_everything = [&](const Eigen::Vector3d& c, double radius, double height) {
     for (const SimObject& o : world.objects) {
       const double other = o.type->size_m / 2.0;
       if ((o.center_m.head<2>() - c.head<2>()).norm() < radius + other &&
@@ -42,11 +41,8 @@ SimWorld CreateWorld(const SeasonConfig& season, uint64_t seed) {
         return false;
       }
     }
-    for (const Structure& s : season.structures) {
-      if (!s.blocks_robot) continue;
-      if (DistanceToStructure(s, c.head<2>()) < radius) return false;
-    }
-    return true;
+    // Not inside a structure nor under a raised one it does not fit under.
+    return !PointBlocksObject(season, c.head<2>(), radius, height);
   };
 
   int next_id = 1;
@@ -68,7 +64,7 @@ SimWorld CreateWorld(const SeasonConfig& season, uint64_t seed) {
           c = Eigen::Vector3d(
               p.region->min_m.x + unit(rng) * (p.region->max_m.x - p.region->min_m.x),
               p.region->min_m.y + unit(rng) * (p.region->max_m.y - p.region->min_m.y), z);
-          if (clear_of_everything(c, radius)) break;
+          if (clear_of_everything(c, radius, ObjectHeight(*type))) break;
         }
         object.center_m = c;
       }

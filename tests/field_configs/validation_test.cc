@@ -38,7 +38,7 @@ TEST_F(SeasonValidationTest, ShippedTextParses) {
 }
 
 TEST_F(SeasonValidationTest, MisspeltKeyIsRejectedWithSuggestion) {
-  const std::string bad = Edit(text_, "  tile_m: 0.6096", "  tiel_m: 0.6096");
+  const std::string bad = Edit(text_, "  tile_m: 0.597", "  tiel_m: 0.597");
   const ConfigError e = Reject(bad);
   EXPECT_EQ(e.key_path(), "field.tiel_m");
   EXPECT_EQ(e.line(), LineOf(bad, "tiel_m"));
@@ -75,22 +75,23 @@ TEST_F(SeasonValidationTest, NegativeSize) {
 }
 
 TEST_F(SeasonValidationTest, ObjectOutsideTheField) {
-  const std::string bad = Edit(text_, "position_m: [1.22, 0.91]", "position_m: [2.50, 0.91]");
+  const std::string bad = Edit(text_, "position_m: [0.61, 1.00]", "position_m: [2.50, 1.00]");
   const ConfigError e = Reject(bad);
   EXPECT_EQ(e.key_path(), "objects[4].position_m");
-  EXPECT_EQ(e.line(), LineOf(bad, "[2.50, 0.91]"));
+  EXPECT_EQ(e.line(), LineOf(bad, "[2.50, 1.00]"));
   EXPECT_NE(e.expected().find("inside the field"), std::string::npos) << e.what();
 }
 
 TEST_F(SeasonValidationTest, OverlappingObjects) {
-  const std::string bad = Edit(text_, "position_m: [1.22, 0.91]", "position_m: [-0.30, 0.95]");
+  const std::string bad =
+      Edit(text_, "position_m: [0.61, 1.00], z_m: 0.35", "position_m: [-0.30, 0.95]");
   const ConfigError e = Reject(bad);
   EXPECT_EQ(e.key_path(), "objects[4].position_m");
   EXPECT_NE(e.expected().find("not overlapping another object"), std::string::npos) << e.what();
 }
 
 TEST_F(SeasonValidationTest, OverlappingStartingTiles) {
-  const std::string bad = Edit(text_, "center_m: [-1.524, 1.524]", "center_m: [-1.524, 0.60]");
+  const std::string bad = Edit(text_, "center_m: [0.2985, 1.40]", "center_m: [-0.8955, 1.00]");
   const ConfigError e = Reject(bad);
   EXPECT_EQ(e.key_path(), "starts[1].center_m");
   EXPECT_NE(e.expected().find("not overlapping another"), std::string::npos) << e.what();
@@ -136,8 +137,8 @@ TEST_F(SeasonValidationTest, UnknownObjectTypeInPoints) {
 }
 
 TEST_F(SeasonValidationTest, EmptyRegion) {
-  const std::string bad = Edit(text_, "min_m: [-1.0, -1.6], max_m: [0.45, 1.6]",
-                               "min_m: [0.45, -1.6], max_m: [-1.0, 1.6]");
+  const std::string bad = Edit(text_, "min_m: [-1.0, -1.15], max_m: [0.45, 1.15]",
+                               "min_m: [0.45, -1.15], max_m: [-1.0, 1.15]");
   const ConfigError e = Reject(bad);
   EXPECT_EQ(e.key_path(), "objects[8].region");
   EXPECT_NE(e.expected().find("min_m below max_m"), std::string::npos) << e.what();
@@ -151,7 +152,7 @@ TEST_F(SeasonValidationTest, BadEnumWord) {
 }
 
 TEST_F(SeasonValidationTest, YamlSyntaxError) {
-  const std::string bad = Edit(text_, "  size_m: 3.658", "  size_m: [3.658");
+  const std::string bad = Edit(text_, "  size_m: 3.566", "  size_m: [3.566");
   const ConfigError e = Reject(bad);
   EXPECT_EQ(e.key_path(), "(document)");
   EXPECT_GT(e.line(), 0);

@@ -77,17 +77,19 @@ TEST_F(ObjectMapTest, EveryStructureIsOccupiedOverItsHeightRange) {
 }
 
 TEST_F(ObjectMapTest, StructuresHaveFreeFloorBesideThem) {
-  // Red goal: cylinder r = 0.14 at (0.45, 0.61); one voxel and a bit away on the -x side.
-  EXPECT_TRUE(map_.IsOccupied({0.45 - 0.13, 0.61, 0.05}));
-  EXPECT_TRUE(IsFree(map_, {0.45 - 0.14 - 0.06, 0.61, 0.05}));
-  // Barrier: 0.05 thick at x = 0.61, open near the side walls (|y| > 1.22).
-  EXPECT_TRUE(map_.IsOccupied({0.61, 0.0, 0.2}));
+  // Red goal: cylinder r = 0.14 at (0.78, 0.61); one voxel and a bit away on the +x side.
+  EXPECT_TRUE(map_.IsOccupied({0.78 + 0.13, 0.61, 0.05}));
+  EXPECT_TRUE(IsFree(map_, {0.78 + 0.14 + 0.06, 0.61, 0.05}));
+  // Barrier: a pipe 0.05 thick at x = 0.61 raised 0.30-0.35 m, open near the side walls
+  // (|y| > 1.22): occupied at its height, free floor under it and beside it.
+  EXPECT_TRUE(map_.IsOccupied({0.61, 0.0, 0.325}));
+  EXPECT_TRUE(IsFree(map_, {0.61, 0.0, 0.05})) << "robots lower than 0.30 m pass under";
   EXPECT_TRUE(IsFree(map_, {0.61 + 0.025 + 0.06, 0.0, 0.05}));
   EXPECT_TRUE(IsFree(map_, {0.61, 1.5, 0.05})) << "the gap by the wall";
   // Elevated hanging bar: occupied at its height, free floor and unknown space below it.
-  EXPECT_TRUE(map_.IsOccupied({-1.22, 1.07, 0.73}));
-  EXPECT_TRUE(IsUnknown(map_, {-1.22, 1.07, 0.4}));
-  EXPECT_TRUE(IsFree(map_, {-1.22, 1.07, 0.05}));
+  EXPECT_TRUE(map_.IsOccupied({-1.45, 1.07, 0.73}));
+  EXPECT_TRUE(IsUnknown(map_, {-1.45, 1.07, 0.4}));
+  EXPECT_TRUE(IsFree(map_, {-1.45, 1.07, 0.05}));
   // The bump (5 cm): occupied in the first layer, free floor layer above it.
   EXPECT_TRUE(map_.IsOccupied({-0.30, 0.0, 0.025}));
   EXPECT_TRUE(IsFree(map_, {-0.30, 0.0, 0.075}));
@@ -137,11 +139,11 @@ TEST_F(ObjectMapTest, OverlappingObjectsKeepTheirVoxelsWhenTheOtherGoes) {
 }
 
 TEST_F(ObjectMapTest, ObjectInsideAStructureLeavesItOccupiedWhenItGoes) {
-  const MappedObject in_goal{1,      "buckyball", "red", Eigen::Vector3d(0.45, 0.61, 0.4),
+  const MappedObject in_goal{1,      "buckyball", "red", Eigen::Vector3d(0.78, 0.61, 0.4),
                              0.0635, 0.127,       1.0};
   map_.SetObjects({in_goal});
   map_.SetObjects({});
-  EXPECT_TRUE(map_.IsOccupied({0.45, 0.61, 0.4}));
+  EXPECT_TRUE(map_.IsOccupied({0.78, 0.61, 0.4}));
 }
 
 TEST_F(ObjectMapTest, ZeroConfidenceObjectsAreNotObstacles) {
@@ -160,18 +162,22 @@ TEST_F(ObjectMapTest, GridMarksTheRedGoalOccupiedAndTheStartTilesFree) {
       EXPECT_TRUE(index.has_value()) << x << ", " << y;
       return index ? grid.cells[*index] : std::uint8_t{42};
     };
-    EXPECT_EQ(at(0.45, 0.61), OccupancyGrid2D::kOccupied) << cell_m;
+    EXPECT_EQ(at(0.78, 0.61), OccupancyGrid2D::kOccupied) << cell_m;
     for (const field::StartTile& start : season_.starts) {
       EXPECT_EQ(at(start.center_m.x, start.center_m.y), OccupancyGrid2D::kFree) << cell_m;
     }
     EXPECT_EQ(at(season_.HalfSize() + 0.02, 0.0), OccupancyGrid2D::kOccupied) << "wall";
     EXPECT_EQ(at(-0.30, 0.0), OccupancyGrid2D::kFree) << "above the bump";
-    EXPECT_EQ(at(-1.22, 1.07), OccupancyGrid2D::kFree) << "under the hanging bar";
+    EXPECT_EQ(at(-1.45, 1.07), OccupancyGrid2D::kFree) << "under the hanging bar";
+    EXPECT_EQ(at(0.61, 0.0), OccupancyGrid2D::kOccupied) << "the barrier, up to 0.5 m";
     EXPECT_FALSE(grid.IndexOf({5.0, 0.0}).has_value());
   }
+  // A grid for a robot lower than the barrier's underside: the barrier is not in it.
+  const OccupancyGrid2D low = map_.ToGrid(0.05, 0.06, 0.25);
+  EXPECT_NE(low.cells[*low.IndexOf({0.61, 0.0})], OccupancyGrid2D::kOccupied);
   // Above the free layer nothing is known but the tall structures.
   const OccupancyGrid2D high = map_.ToGrid(0.05, 0.5, 0.8);
-  EXPECT_EQ(high.cells[*high.IndexOf({0.45, 0.61})], OccupancyGrid2D::kOccupied);
+  EXPECT_EQ(high.cells[*high.IndexOf({0.78, 0.61})], OccupancyGrid2D::kOccupied);
   EXPECT_EQ(high.cells[*high.IndexOf({0.0, -1.0})], OccupancyGrid2D::kUnknown);
 }
 
@@ -202,7 +208,7 @@ TEST_F(ObjectMapTest, BinaryFileReadsBackWithTheSameLeaves) {
   ASSERT_TRUE(read.readBinary(path));
   EXPECT_DOUBLE_EQ(read.getResolution(), map_.options().resolution_m);
   EXPECT_EQ(read.getNumLeafNodes(), map_.tree().getNumLeafNodes());
-  const octomap::OcTreeNode* goal = read.search(0.45, 0.61, 0.4);
+  const octomap::OcTreeNode* goal = read.search(0.78, 0.61, 0.4);
   ASSERT_NE(goal, nullptr);
   EXPECT_TRUE(read.isNodeOccupied(goal));
   EXPECT_EQ(read.search(0.0, -1.0, 0.5), nullptr);
@@ -225,9 +231,9 @@ TEST_F(ObjectMapTest, ColouredFileHasStructureAndObjectColours) {
     const field::Rgb c = season_.colours.at(name);
     return octomap::ColorOcTreeNode::Color(c.r, c.g, c.b);
   };
-  EXPECT_EQ(colour_at(0.45, 0.61, 0.4), palette("red"));
-  EXPECT_EQ(colour_at(0.45, -0.61, 0.4), palette("blue"));
-  EXPECT_EQ(colour_at(0.61, 0.0, 0.2), palette("pvc_white"));
+  EXPECT_EQ(colour_at(0.78, 0.61, 0.4), palette("red"));
+  EXPECT_EQ(colour_at(0.78, -0.61, 0.4), palette("blue"));
+  EXPECT_EQ(colour_at(0.61, 0.0, 0.325), palette("pvc_white"));
   EXPECT_EQ(colour_at(season_.HalfSize() + 0.025, 0.0, 0.1), palette("wall_grey"));
   EXPECT_EQ(colour_at(0.0, -1.0, 0.0635), palette("blue"));
   EXPECT_EQ(colour_at(1.0, 1.0, 0.025), palette("tile_grey")) << "free floor";
@@ -249,10 +255,10 @@ TEST_F(ObjectMapTest, FinerResolutionKeepsTheSameShapes) {
   ObjectMapOptions options;
   options.resolution_m = 0.02;
   const ObjectMap fine(season_, options);
-  EXPECT_TRUE(fine.IsOccupied({-1.22, 0.76, 0.4})) << "a 6 cm post";
-  EXPECT_TRUE(IsFree(fine, {-1.22 + 0.06, 0.76, 0.05}));
+  EXPECT_TRUE(fine.IsOccupied({-1.45, 0.76, 0.4})) << "a 6 cm post";
+  EXPECT_TRUE(IsFree(fine, {-1.45 + 0.06, 0.76, 0.05}));
   const OccupancyGrid2D grid = fine.ToGrid(0.02, 0.06, 0.5);
-  EXPECT_EQ(grid.cells[*grid.IndexOf({0.45, 0.61})], OccupancyGrid2D::kOccupied);
+  EXPECT_EQ(grid.cells[*grid.IndexOf({0.78, 0.61})], OccupancyGrid2D::kOccupied);
 }
 
 }  // namespace

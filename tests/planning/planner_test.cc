@@ -69,13 +69,13 @@ field::RobotConfig* PlannerTest::robot_ = nullptr;
 
 TEST_F(PlannerTest, SolvesFromTheRedStartAroundTheField) {
   const Planner planner = MakePlanner(*season_);
-  const PlanResult result = planner.Plan(Request(-1.524, 0.3048, 0.3, -1.2));
+  const PlanResult result = planner.Plan(Request(-0.8955, 1.40, 0.3, -1.2));
   ASSERT_EQ(result.status, PlanStatus::kSolved) << PlanStatusName(result.status);
   ASSERT_GE(result.path.size(), 2u);
-  EXPECT_NEAR(result.path.front().x(), -1.524, 1e-9);
+  EXPECT_NEAR(result.path.front().x(), -0.8955, 1e-9);
   EXPECT_NEAR(result.path.back().y(), -1.2, 1e-9);
   ExpectPathClear(planner, result.path);
-  const double straight_m = (Eigen::Vector2d(0.3, -1.2) - Eigen::Vector2d(-1.524, 0.3048)).norm();
+  const double straight_m = (Eigen::Vector2d(0.3, -1.2) - Eigen::Vector2d(-0.8955, 1.40)).norm();
   EXPECT_GE(result.length_m, straight_m - 1e-9);
   EXPECT_GT(result.travel_time_s, 0.0);
 }
@@ -83,7 +83,7 @@ TEST_F(PlannerTest, SolvesFromTheRedStartAroundTheField) {
 TEST_F(PlannerTest, EveryPlannerSolvesAnOpenQuery) {
   const Planner planner = MakePlanner(*season_);
   for (const std::string& name : PlannerNames()) {
-    PlanRequest request = Request(-1.524, 0.3048, 0.3, -1.2);
+    PlanRequest request = Request(-0.8955, 1.40, 0.3, -1.2);
     request.planner = name;
     request.time_budget_s = 0.3;
     const PlanResult result = planner.Plan(request);
@@ -110,7 +110,7 @@ TEST_F(PlannerTest, IterationBoundedPlansDependOnlyOnTheSeed) {
         while (busy && !stop) x = x + 1.0;
       });
       SeedPlanners(7);
-      PlanRequest request = Request(-1.524, 0.3048, 0.3, -1.2);
+      PlanRequest request = Request(-0.8955, 1.40, 0.3, -1.2);
       request.time_budget_s = budget_s;
       request.max_iterations = 10000;
       const PlanResult r = planner.Plan(request);
@@ -141,8 +141,8 @@ TEST_F(PlannerTest, IterationBoundedPlansDependOnlyOnTheSeed) {
 
 TEST_F(PlannerTest, StartOrGoalInsideTheRedGoalIsInvalid) {
   const Planner planner = MakePlanner(*season_);
-  EXPECT_EQ(planner.Plan(Request(0.45, 0.61, -1.524, 0.3048)).status, PlanStatus::kInvalidStart);
-  EXPECT_EQ(planner.Plan(Request(-1.524, 0.3048, 0.45, 0.61)).status, PlanStatus::kInvalidGoal);
+  EXPECT_EQ(planner.Plan(Request(0.78, 0.61, -0.8955, 1.40)).status, PlanStatus::kInvalidStart);
+  EXPECT_EQ(planner.Plan(Request(-0.8955, 1.40, 0.78, 0.61)).status, PlanStatus::kInvalidGoal);
 }
 
 TEST_F(PlannerTest, EnclosedGoalEndsUnsolvedWithinBudget) {
@@ -165,7 +165,7 @@ TEST_F(PlannerTest, EnclosedGoalEndsUnsolvedWithinBudget) {
   const Planner planner = MakePlanner(season);
   ASSERT_TRUE(planner.IsClear({0.0, -1.0}));
 
-  PlanRequest request = Request(-1.524, 0.3048, 0.0, -1.0);
+  PlanRequest request = Request(-0.8955, 1.40, 0.0, -1.0);
   request.time_budget_s = 0.2;
   const auto start = std::chrono::steady_clock::now();
   const PlanResult result = planner.Plan(request);
@@ -181,7 +181,7 @@ mapping::MappedObject BallAcrossThePath(int id) {
   ball.id = id;
   ball.type = "large_ball";
   ball.colour = "red";
-  ball.centre_m = {-0.612, -0.448, 0.2};
+  ball.centre_m = {-0.29775, 0.10, 0.2};
   ball.radius_m = 0.2;
   ball.height_m = 0.4;
   return ball;
@@ -189,14 +189,15 @@ mapping::MappedObject BallAcrossThePath(int id) {
 
 TEST_F(PlannerTest, PathIsClearChecksTheRemainingSegments) {
   const Planner planner = MakePlanner(*season_);
-  const std::vector<Eigen::Vector2d> path = {{-1.524, 0.3048}, {-1.0, -0.5}, {0.3, -1.2}};
+  const std::vector<Eigen::Vector2d> path = {{-0.8955, 1.40}, {-1.0, -0.5}, {0.3, -1.2}};
   EXPECT_TRUE(planner.PathIsClear(path));
   EXPECT_TRUE(planner.PathIsClear(path, 1));
   EXPECT_TRUE(planner.PathIsClear(path, 2));  // the goal alone
   EXPECT_FALSE(planner.PathIsClear(path, 3));
   EXPECT_FALSE(planner.PathIsClear({}));
-  // Through the red goal (0.45, 0.61): the first segment is blocked, the rest is not.
-  const std::vector<Eigen::Vector2d> through = {{-0.5, 0.61}, {1.2, 0.61}, {1.2, -0.3}};
+  // Through the red goal (0.78, 0.61), in the goal zone: the first segment is blocked, the
+  // rest is not.
+  const std::vector<Eigen::Vector2d> through = {{0.95, 1.3}, {0.95, 0.0}, {1.4, 0.0}};
   ASSERT_TRUE(planner.IsClear(through[0]));
   ASSERT_TRUE(planner.IsClear(through[1]));
   EXPECT_FALSE(planner.PathIsClear(through));
@@ -210,7 +211,7 @@ TEST_F(PlannerTest, ReplansWhenAnObjectLandsOnThePath) {
   Planner planner(*robot_);
   planner.SetMap(map);
   SeedPlanners(7);
-  PlanRequest request = Request(-1.524, 0.3048, 0.3, -1.2);
+  PlanRequest request = Request(-0.8955, 1.40, 0.3, -1.2);
   const PlanResult first = planner.Plan(request);
   ASSERT_EQ(first.status, PlanStatus::kSolved);
   ASSERT_TRUE(planner.PathIsClear(first.path));
@@ -247,8 +248,8 @@ TEST_F(PlannerTest, TheTargetObjectIsNoObstacle) {
   mapping::ObjectMap map(*season_, map_options);
   const std::vector<mapping::MappedObject> objects = {BallAcrossThePath(4)};
   map.SetObjects(objects);
-  const std::vector<Eigen::Vector2d> line = {{-1.524, 0.3048}, {0.3, -1.2}};
-  const Eigen::Vector2d ball(-0.612, -0.448);
+  const std::vector<Eigen::Vector2d> line = {{-0.8955, 1.40}, {0.3, -1.2}};
+  const Eigen::Vector2d ball(-0.29775, 0.10);
 
   Planner planner(*robot_);
   planner.SetMap(map);  // every object is an obstacle
@@ -275,9 +276,9 @@ TEST_F(PlannerTest, TheTargetObjectIsNoObstacle) {
 
 TEST_F(PlannerTest, ShortenKeepsTheEndsAndNeverLengthens) {
   const Planner planner = MakePlanner(*season_);
-  // A zigzag in open floor pulls to the straight line.
+  // A zigzag in open floor (the goal zone beyond the stashes) pulls to the straight line.
   const std::vector<Eigen::Vector2d> zigzag = {
-      {1.0, -1.0}, {1.2, -0.5}, {1.0, 0.0}, {1.3, 0.5}, {1.0, 1.0}};
+      {1.25, -1.0}, {1.45, -0.5}, {1.25, 0.0}, {1.45, 0.5}, {1.25, 1.0}};
   ASSERT_TRUE(planner.PathIsClear(zigzag));
   const std::vector<Eigen::Vector2d> taut = planner.Shorten(zigzag);
   EXPECT_EQ(taut.size(), 2u);
@@ -293,7 +294,7 @@ TEST_F(PlannerTest, ShortenKeepsTheEndsAndNeverLengthens) {
   Planner loose(*robot_, options);
   loose.SetMap(map);
   SeedPlanners(3);
-  const PlanResult result = loose.Plan(Request(-1.524, 0.3048, 0.3, -1.2));
+  const PlanResult result = loose.Plan(Request(-0.8955, 1.40, 0.3, -1.2));
   ASSERT_EQ(result.status, PlanStatus::kSolved);
   const std::vector<Eigen::Vector2d> around = loose.Shorten(result.path);
   EXPECT_LE(PathLength(around), result.length_m + 1e-12);

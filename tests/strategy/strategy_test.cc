@@ -48,8 +48,12 @@ TEST_F(StrategyTest, PointsFollowTheSeasonRules) {
   EXPECT_EQ(GoalPoints(season_, Goal("red_stash"), "large_ball", "red", field::Alliance::kRed), 10);
   EXPECT_EQ(GoalPoints(season_, Goal("blue_stash"), "buckyball", "red", field::Alliance::kRed), 0);
   EXPECT_EQ(GoalPoints(season_, Goal("red_stash"), "buckyball", "blue", field::Alliance::kRed), 0);
+  // The hanging zone (behind the bump, x < -0.2985) scores nothing; the middle zone 1.
   EXPECT_EQ(
       FloorPoints(season_, Eigen::Vector2d(-1.0, 0.0), "buckyball", "red", field::Alliance::kRed),
+      0);
+  EXPECT_EQ(
+      FloorPoints(season_, Eigen::Vector2d(0.2, 0.0), "buckyball", "red", field::Alliance::kRed),
       1);
   EXPECT_EQ(
       FloorPoints(season_, Eigen::Vector2d(1.2, 0.0), "large_ball", "red", field::Alliance::kRed),
@@ -70,16 +74,18 @@ TEST_F(StrategyTest, StashIsApproachedFromItsOpenSideOnly) {
   const std::vector<Eigen::Vector3d> stages = ScoreStages(context_, stash, 0.0635, 0.15);
   ASSERT_FALSE(stages.empty());
   for (const Eigen::Vector3d& s : stages) {
-    EXPECT_LT(s.x(), 0.45) << "the barrier is behind the stash";
+    // The stash (0.78, 0.61) stands beyond the barrier (x = 0.61), which the 0.60 m thesis
+    // robot cannot pass under: it is released into from the goal zone's side only.
+    EXPECT_GT(s.x(), 0.78) << "the barrier is in front of the stash";
     EXPECT_TRUE(planner_->IsClear(s.head<2>()));
     // Facing the stash's centre.
-    const Eigen::Vector2d to_goal = Eigen::Vector2d(0.45, 0.61) - s.head<2>();
+    const Eigen::Vector2d to_goal = Eigen::Vector2d(0.78, 0.61) - s.head<2>();
     EXPECT_NEAR(std::remainder(std::atan2(to_goal.y(), to_goal.x()) - s.z(), 2 * M_PI), 0.0, 1e-6);
   }
 }
 
 TEST_F(StrategyTest, TravelTimesAreNeverShorterThanTheStraightLine) {
-  const Eigen::Vector3d from(-1.524, 0.3048, 0.0), to(-0.5, -1.0, 0.0);
+  const Eigen::Vector3d from(-0.8955, 1.40, 0.0), to(-1.0, -1.0, 0.0);
   const std::optional<double> d = travel_->DistanceM(from.head<2>(), to.head<2>());
   ASSERT_TRUE(d);
   EXPECT_GE(*d, (to - from).head<2>().norm() - 1e-9);
@@ -87,14 +93,27 @@ TEST_F(StrategyTest, TravelTimesAreNeverShorterThanTheStraightLine) {
   const std::optional<double> t = travel_->TravelTimeS(from, to);
   ASSERT_TRUE(t);
   EXPECT_GT(*t, planning::DriveTime(robot_.drive, *d));
-  // Inside a structure: unreachable.
-  EXPECT_FALSE(travel_->DistanceM(from.head<2>(), Eigen::Vector2d(0.45, 0.61)));
+  // Inside a structure: unreachable; so is the point under the barrier for the 0.60 m robot.
+  EXPECT_FALSE(travel_->DistanceM(from.head<2>(), Eigen::Vector2d(0.78, 0.61)));
+  EXPECT_FALSE(travel_->DistanceM(from.head<2>(), Eigen::Vector2d(0.61, 0.0)));
+  // A robot lower than the barrier's underside (0.30 m) drives straight under it.
+  field::RobotConfig low = robot_;
+  low.height_m = 0.25;
+  planning::Planner low_planner(low);
+  low_planner.SetMap(*map_);
+  TravelField low_travel(low.drive);
+  low_travel.SetPlanner(low_planner);
+  const Eigen::Vector2d near(0.2, 0.0), beyond(1.0, 0.0);
+  const std::optional<double> under = low_travel.DistanceM(near, beyond);
+  ASSERT_TRUE(under);
+  EXPECT_LT(*under, 1.05 * (beyond - near).norm());
+  EXPECT_FALSE(travel_->DistanceM(near, Eigen::Vector2d(0.61, 0.0)));
 }
 
 TEST_F(StrategyTest, PlannerScoresTheHeldObjectAndIdlesWhenNothingFits) {
   std::unique_ptr<Strategy> planner = MakeStrategy("planner", StrategyOptions{});
   Belief b;
-  b.pose = Eigen::Vector3d(-1.524, 0.3048, 0.0);
+  b.pose = Eigen::Vector3d(-0.8955, 1.40, 0.0);
   b.held =
       ObjectBelief{-1, "buckyball", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
   EXPECT_EQ(planner->Next(b, context_).kind, ActionKind::kObserve);  // the initial survey
@@ -142,6 +161,78 @@ TEST_F(StrategyTest, UnknownStrategyIsAnError) {
   EXPECT_THROW(MakeStrategy("random", StrategyOptions{}), std::invalid_argument);
   for (const std::string& name : StrategyNames())
     EXPECT_EQ(MakeStrategy(name, StrategyOptions{})->name(), name);
+}
+
+// A red large ball believed on the barrier (it cannot be on the floor there: it does not fit
+// under) is not picked: the perceiving strategies knock it off, driving at it along +x so that
+// it drops into the goal zone (5) rather than back into the middle zone (1), and only once.
+TEST_F(StrategyTest, ABallOnTheBarrierIsKnockedIntoTheGoalZoneNotPicked) {
+  for (const std::string name : {"planner", "greedy"}) {
+    std::unique_ptr<Strategy> strategy = MakeStrategy(name, StrategyOptions{});
+    Belief b;
+    b.pose = Eigen::Vector3d(-0.9, 1.0, 0.0);
+    b.objects.push_back(ObjectBelief{7, "large_ball", "red", Eigen::Vector2d(0.61, 1.0),
+                                     Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    EXPECT_EQ(strategy->Next(b, context_).kind, ActionKind::kObserve) << name;  // survey
+    Action a = strategy->Next(b, context_);
+    for (int k = 0; k < 3 && a.kind == ActionKind::kObserve; ++k) a = strategy->Next(b, context_);
+    ASSERT_EQ(a.kind, ActionKind::kNavigate) << name << ": " << a.why;
+    EXPECT_FALSE(a.push) << name;
+    EXPECT_EQ(a.object_id, 7) << name;
+    EXPECT_LT(a.target.x(), 0.61) << name;
+    EXPECT_NEAR(std::remainder(a.target.z(), 2 * M_PI), 0.0, 1e-6) << name;
+    // At the run-in stage: the push itself, straight on towards the barrier.
+    b.pose = a.target;
+    Action push = strategy->Next(b, context_);
+    for (int k = 0; k < 3 && push.kind == ActionKind::kObserve; ++k)
+      push = strategy->Next(b, context_);
+    ASSERT_EQ(push.kind, ActionKind::kNavigate) << name << ": " << push.why;
+    EXPECT_TRUE(push.push) << name;
+    EXPECT_EQ(push.object_id, 7) << name;
+    EXPECT_EQ(push.goal_index, Goal("goal_zone")) << name;
+    EXPECT_GT(push.target.x(), a.target.x() + 0.2) << name;
+    EXPECT_NEAR(push.target.y(), 1.0, 1e-6) << name;
+    EXPECT_TRUE(planner_->IsClear(push.target.head<2>())) << name;
+    // Done once: believed still there, it is not pushed again.
+    strategy->Feedback(push, true);
+    b.pose = push.target;
+    const Action after = strategy->Next(b, context_);
+    EXPECT_FALSE(after.kind == ActionKind::kNavigate && after.object_id == 7) << name;
+  }
+}
+
+// The scripted route from the red hanging-zone tile, planned on the nominal layout: it
+// releases the preload, knocks a red large ball off the barrier, and its planned actions
+// fit in the period.
+TEST_F(StrategyTest, ScriptedRouteScoresThePreloadAndKnocksTheBarrierBalls) {
+  std::unique_ptr<Strategy> scripted = MakeStrategy("scripted", StrategyOptions{});
+  EXPECT_FALSE(scripted->perceives());
+  Belief b;
+  b.pose = Eigen::Vector3d(-0.8955, 1.40, 0.0);
+  b.held =
+      ObjectBelief{-1, "buckyball", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
+  std::vector<Action> route;
+  for (Action a = scripted->Next(b, context_); a.kind != ActionKind::kIdle;
+       a = scripted->Next(b, context_)) {
+    route.push_back(a);
+    ASSERT_LT(route.size(), 100u);
+  }
+  ASSERT_FALSE(route.empty());
+  int scores = 0, pushes = 0;
+  double planned_s = 0.0;
+  for (const Action& a : route) {
+    scores += a.kind == ActionKind::kScore;
+    pushes += a.push;
+    planned_s += a.expected_s;
+    if (a.push) {
+      EXPECT_LT(std::abs(std::remainder(a.target.z(), 2 * M_PI)), M_PI / 2)
+          << "pushed towards the goal zone";
+    }
+  }
+  EXPECT_EQ(route.front().kind, ActionKind::kNavigate);
+  EXPECT_GE(scores, 1);
+  EXPECT_GE(pushes, 1);  // a red large ball off the barrier
+  EXPECT_LE(planned_s, b.deadline_s);
 }
 
 }  // namespace

@@ -239,7 +239,7 @@ TEST_F(DepthToPointsTest, LevelledFrameUndoesThePitch) {
 }
 
 // End to end on the simulator: the robot at (1.0, 0) faces the +x perimeter wall (inner face
-// at x = 1.829); the camera, 0.1 m ahead of the centre, is 0.729 m from it along the floor.
+// at x = 1.783); the camera, 0.1 m ahead of the centre, is 0.683 m from it along the floor.
 // Pitched 15 deg down it sees the wall in the middle rows, the floor below and nothing over
 // the 0.3 m wall: levelling and dropping the floor leaves the wall, whose plane distance
 // after the depth correction is the truth within 1 cm (the raw depth reads ~26 mm long).
@@ -253,7 +253,7 @@ TEST(DepthCalibrationSimTest, WallDistanceFromARenderedFrame) {
   const platform::RgbdFrame frame =
       renderer.Render(world, platform::Pose2D{1.0, 0.0, 0.0}, 0.0, nullptr);
   const CameraModel camera(robot.camera);
-  const double truth_m = 1.829 - (1.0 + robot.camera.mount.x_m);
+  const double truth_m = season.HalfSize() - (1.0 + robot.camera.mount.x_m);
 
   const std::optional<PlaneFit> fit = FitPlaneRansac(
       LevelAboveFloor(DepthToPoints(frame.depth_mm, camera, true), camera, 0.03), {});

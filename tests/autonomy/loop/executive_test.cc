@@ -114,7 +114,7 @@ class FarAway : public strategy::Strategy {
   strategy::Action Next(const strategy::Belief&, const strategy::StrategyContext&) override {
     strategy::Action a;
     a.kind = strategy::ActionKind::kNavigate;
-    a.target = Eigen::Vector3d(1.2, -1.3, 0.0);
+    a.target = Eigen::Vector3d(0.2, -1.3, 0.0);  // across the field, this side of the barrier
     a.expected_s = claimed_s_;
     a.why = "far away";
     return a;

@@ -14,11 +14,11 @@ TEST(FieldPictureTest, DrawsObjectsAndLandmarksAtTheirPositions) {
   FieldPictureOptions options;
   FieldCanvas canvas(season, options);
   const cv::Mat picture = DrawFieldPicture(season, options);
-  EXPECT_EQ(picture.cols, canvas.ToPixels(3.658) + 2 * options.margin_px + options.legend_width_px);
+  EXPECT_EQ(picture.cols, canvas.ToPixels(3.566) + 2 * options.margin_px + options.legend_width_px);
 
-  // A fixed red buckyball at (-1.52, 1.22): its centre pixel is the palette's red.
+  // A fixed red buckyball (a preload) at (-0.8955, 1.40): its centre pixel is the palette's red.
   const field::Rgb red = season.colours.at("red");
-  const cv::Vec3b ball = At(picture, canvas.ToPixel(-1.52, 1.22));
+  const cv::Vec3b ball = At(picture, canvas.ToPixel(-0.8955, 1.40));
   EXPECT_EQ(ball, cv::Vec3b(red.b, red.g, red.r));
 
   // The first landmark's centre is its colour.
@@ -29,7 +29,7 @@ TEST(FieldPictureTest, DrawsObjectsAndLandmarksAtTheirPositions) {
 
   // An empty tile centre is the tile colour.
   const field::Rgb tile = season.colours.at(season.field.tile_colour);
-  EXPECT_EQ(At(picture, canvas.ToPixel(-0.9144, 1.524)), cv::Vec3b(tile.b, tile.g, tile.r));
+  EXPECT_EQ(At(picture, canvas.ToPixel(-1.4925, -0.2985)), cv::Vec3b(tile.b, tile.g, tile.r));
 }
 
 TEST(FieldPictureTest, EverySeasonDraws) {

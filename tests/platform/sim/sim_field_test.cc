@@ -60,14 +60,64 @@ TEST_F(SimFieldTest, RobotPushesABallInItsWay) {
 }
 
 TEST_F(SimFieldTest, BallPinnedAgainstTheWallStopsTheRobot) {
-  Place("buckyball", "red", -1.2, -1.70);  // against the side wall (y = -1.829)
-  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-1.2, -1.1, -kPi / 2.0});
+  // The robot drives along the left wall (x = -1.783) into the corner, where a ball lies
+  // against the side wall (y = -1.783). It cannot roll out past the bumper's wall side, and a
+  // post blocks the other side: pinned, it stops the robot.
+  const double x = -season_.HalfSize() + robot_.width_m / 2.0 + 0.01;
+  Place("buckyball", "red", x, -1.70);
+  field::Structure post;
+  post.name = "post";
+  post.shape = field::SolidShape::kCylinder;
+  post.center_m = field::Vec2{x + robot_.width_m / 2.0 + 0.0635 + 0.03, -1.70};
+  post.radius_m = 0.03;
+  post.height_m = 0.5;
+  season_.structures.push_back(post);
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{x, -1.1, -kPi / 2.0});
   Drive(&field, "forward 0.6");
   const SimObject& ball = field.world().objects[0];
   EXPECT_GE(std::abs(ball.center_m.y()), 1.70 - 1e-9);  // never pushed into the wall
   EXPECT_LE(std::abs(ball.center_m.y()), season_.HalfSize() - 0.0635 + 1e-9);
   // The robot stopped with the ball between its bumper and the wall.
   EXPECT_GT(field.robot_pose().y_m, -1.70 + robot_.length_m / 2.0);
+}
+
+TEST_F(SimFieldTest, PinnedBallWithAFreeSideRollsOutPastTheBumper) {
+  // The same ball against the side wall, met in the open: it rolls out past the bumper's side
+  // and the robot drives on to the wall.
+  Place("buckyball", "red", -0.9, -1.70);
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{-0.9, -1.1, -kPi / 2.0});
+  Drive(&field, "forward 0.6");
+  const SimObject& ball = field.world().objects[0];
+  EXPECT_GT(std::abs(ball.center_m.x() + 0.9), robot_.width_m / 2.0);
+  EXPECT_LT(field.robot_pose().y_m, -1.70 + robot_.length_m / 2.0);
+}
+
+// Toss Up's barrier (x = 0.61, raised 0.30 m): a large ball on it scores nothing there; the
+// thesis robot (0.60 m tall) cannot pass under it, but driving into the barrier knocks the ball
+// off into the goal zone (5 points for red).
+TEST_F(SimFieldTest, LargeBallKnockedOffTheBarrierScoresInTheGoalZone) {
+  Place("large_ball", "red", 0.61, 1.0);
+  season_.objects.back().z_m = 0.35;
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{0.0, 1.0, 0.0});
+  EXPECT_EQ(field.Score(Alliance::kRed), 0);
+  Drive(&field, "forward 0.5");
+  // Stopped by the barrier: the body never went under it.
+  EXPECT_LT(field.robot_pose().x_m + robot_.length_m / 2.0, 0.585 + 0.01);
+  const SimObject& ball = field.world().objects[0];
+  EXPECT_GT(ball.center_m.x(), 0.635);         // off the barrier's far side
+  EXPECT_NEAR(ball.center_m.z(), 0.20, 1e-6);  // on the floor
+  EXPECT_EQ(field.Score(Alliance::kRed), 5);
+}
+
+// A robot lower than the barrier's underside drives under it, and so does a buckyball it pushes.
+TEST_F(SimFieldTest, LowRobotDrivesUnderTheBarrier) {
+  robot_.height_m = 0.25;
+  Place("buckyball", "red", 0.40, 0.0);  // between the stashes
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{0.0, 0.0, 0.0});
+  Drive(&field, "forward 0.9");
+  EXPECT_GT(field.robot_pose().x_m, 0.61);                 // its centre past the barrier's line
+  EXPECT_GT(field.world().objects[0].center_m.x(), 0.61);  // pushed into the goal zone
+  EXPECT_EQ(field.Score(Alliance::kRed), 2);
 }
 
 TEST_F(SimFieldTest, IntakePicksOnlyWithinReachInFront) {
@@ -105,9 +155,10 @@ TEST_F(SimFieldTest, ReleaseInTheGoalZoneScoresByTheRules) {
 }
 
 TEST_F(SimFieldTest, ReleaseOverTheStashScoresTheGoal) {
-  // The red stash is a cylinder at (0.45, 0.61), radius 0.14: drop into it from the west.
-  Place("buckyball", "red", 0.45 - 0.14 - 0.30 + 0.05, 0.61);
-  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{0.45 - 0.14 - 0.30 - 0.225, 0.61, 0.0});
+  // The red stash is a cylinder at (0.78, 0.61), radius 0.14, beyond the barrier: drop into it
+  // from the goal zone, facing west.
+  Place("buckyball", "red", 0.78 + 0.14 + 0.30 - 0.05, 0.61);
+  SimField field(season_, robot_, Alliance::kRed, 1, Pose2D{0.78 + 0.14 + 0.30 + 0.225, 0.61, kPi});
   ASSERT_TRUE(field.Pick().has_value());
   // Drive up to the stash (the ball is held, so the bumper reaches the goal).
   Drive(&field, "forward 0.35");  // stops against the stash

@@ -22,11 +22,11 @@ void BM_RenderFrame(benchmark::State& state, Pose2D pose, bool with_objects) {
   state.SetLabel(std::to_string(robot.camera.width_px) + "x" +
                  std::to_string(robot.camera.height_px));
 }
-BENCHMARK_CAPTURE(BM_RenderFrame, start_tile, Pose2D{-1.524, 0.3048, 0.0}, true)
+BENCHMARK_CAPTURE(BM_RenderFrame, start_tile, Pose2D{-0.8955, 1.40, 0.0}, true)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_RenderFrame, mid_field, Pose2D{-0.9, 0.0, 0.0}, true)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_RenderFrame, start_tile_no_objects, Pose2D{-1.524, 0.3048, 0.0}, false)
+BENCHMARK_CAPTURE(BM_RenderFrame, start_tile_no_objects, Pose2D{-0.8955, 1.40, 0.0}, false)
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
