@@ -65,14 +65,14 @@ void MakeTouchingPair(platform::SimWorld* world, std::mt19937_64* rng) {
 void AddArenaOpponents(const field::SeasonConfig& season, const Pose2D& robot, int count,
                        platform::SimWorld* world, std::mt19937_64* rng) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  constexpr double kSize = 0.457;  // an 18 in robot
+  constexpr double kSize = 0.457;  // an 18 in robot, as tall as it is long
   for (int k = 0; k < count; ++k) {
     for (int attempt = 0; attempt < 200; ++attempt) {
       const double bearing = robot.theta_rad + (unit(*rng) - 0.5) * (attempt < 100 ? 1.2 : 6.3);
       const double range = 1.0 + 2.0 * unit(*rng);
       const Pose2D pose{robot.x_m + range * std::cos(bearing),
                         robot.y_m + range * std::sin(bearing), 2.0 * M_PI * unit(*rng)};
-      if (!platform::FootprintIsFree(season, pose, kSize + 0.05, kSize + 0.05)) continue;
+      if (!platform::FootprintIsFree(season, pose, kSize + 0.05, kSize + 0.05, kSize)) continue;
       const auto clear = [&](double x, double y, double r) {
         return std::hypot(x - pose.x_m, y - pose.y_m) > kSize / std::sqrt(2.0) + r;
       };
