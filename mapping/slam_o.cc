@@ -135,21 +135,25 @@ LandmarkFrame SlamO::UpdateLandmarks(const platform::RgbdFrame& frame) {
   return out;
 }
 
-void SlamO::TrackObjects(const platform::RgbdFrame& frame, double t_s) {
+ObjectFrame SlamO::TrackObjects(const platform::RgbdFrame& frame, double t_s) {
   std::vector<ObjectObservation> seen;
   const Eigen::Vector3d pose = ekf_.pose();
-  std::vector<vision::Detection> detections =
-      vision::Detect(frame.colour, frame.depth_mm, object_detector_, {});
-  if (options_.field_gate) {
-    vision::FieldGateOptions gate;
-    gate.pose_sigma_m = std::sqrt(ekf_.pose_covariance().topLeftCorner<2, 2>().trace());
-    detections = vision::RejectOffField(detections, *object_detector_.camera, pose, field_bounds_,
-                                        gate, {}, &rejected_by_geometry_);
-  }
-  for (const vision::Detection& d : detections) {
-    if (!d.measurement) continue;
-    seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
-                    d.measurement->covariance});
+  ObjectFrame out;
+  vision::FieldGateOptions gate;
+  gate.pose_sigma_m = std::sqrt(ekf_.pose_covariance().topLeftCorner<2, 2>().trace());
+  for (vision::Detection& d : vision::Detect(frame.colour, frame.depth_mm, object_detector_, {})) {
+    DetectionUse use = DetectionUse::kTracked;
+    if (options_.field_gate &&
+        !vision::OnField(d, *object_detector_.camera, pose, field_bounds_, gate)) {
+      use = DetectionUse::kOffField;
+      ++rejected_by_geometry_;
+    } else if (!d.measurement) {
+      use = DetectionUse::kNoRange;
+    } else {
+      seen.push_back({d.kind, d.colour, d.measurement->range_m, d.measurement->bearing_rad,
+                      d.measurement->covariance});
+    }
+    out.detections.push_back({std::move(d), use});
   }
   // Placed through the best pose estimate (and its covariance); objects in view and range but
   // not seen lose confidence.
@@ -159,6 +163,7 @@ void SlamO::TrackObjects(const platform::RgbdFrame& frame, double t_s) {
     return z.x() > options_.object_min_range_m && z.x() < options_.object_max_range_m &&
            std::abs(z.y()) < half_fov;
   });
+  return out;
 }
 
 std::vector<TrackedObject> SlamO::ConfirmedObjects(const std::vector<int>& taken_ids) const {

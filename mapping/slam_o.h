@@ -78,6 +78,21 @@ struct LandmarkFrame {
   bool more_frames = false;                // the frame rule wants another frame at this stop
 };
 
+// What one frame's object detection saw, each detection with what became of it (for a picture
+// of what the robot saw; the tracker has taken the used ones).
+enum class DetectionUse {
+  kTracked,   // given to the object tracker
+  kOffField,  // dropped by the field gate (vision/field_gate.h)
+  kNoRange,   // on the field as far as known, but without a range: not tracked
+};
+struct ObjectFrame {
+  struct Seen {
+    vision::Detection detection;
+    DetectionUse use = DetectionUse::kTracked;
+  };
+  std::vector<Seen> detections;  // in the detector's order
+};
+
 // Where the filter starts, and what it is told of the field.
 struct SlamOPrior {
   Eigen::Vector3d pose = Eigen::Vector3d::Zero();
@@ -108,8 +123,8 @@ class SlamO {
   void BeginStop(const FrameSelectionOptions& rule = {});
   // 3. One frame's markers into the EKF.
   LandmarkFrame UpdateLandmarks(const platform::RgbdFrame& frame);
-  // 4. One frame's objects into the tracker at t_s.
-  void TrackObjects(const platform::RgbdFrame& frame, double t_s);
+  // 4. One frame's objects into the tracker at t_s; returns every detection and its use.
+  ObjectFrame TrackObjects(const platform::RgbdFrame& frame, double t_s);
   // 5. The confirmed objects, less those taken off the field, into the object map and, by
   // `obstacles` when given, the planner's obstacle map.
   void UpdateMaps(const std::vector<int>& taken_ids = {},

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
 
 #include "mapping/ekf_slam.h"
 #include "mapping/metrics.h"
@@ -82,6 +83,29 @@ double PoseAte(const std::vector<PoseSample>& samples) {
   }
   if (truth.empty()) return std::numeric_limits<double>::quiet_NaN();
   return mapping::PairedTrajectoryError(truth, estimate, /*align=*/false).rmse_m;
+}
+
+CameraView MakeCameraView(const platform::RgbdFrame& frame, const mapping::ObjectFrame& objects,
+                          double t_s, int width) {
+  CameraView view;
+  view.t_s = t_s;
+  const cv::Mat& colour = frame.colour;
+  if (colour.empty() || width <= 0) return view;
+  const double scale = static_cast<double>(width) / colour.cols;
+  const int height = std::max(1, static_cast<int>(std::lround(colour.rows * scale)));
+  cv::resize(colour, view.image, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  for (const mapping::ObjectFrame::Seen& s : objects.detections) {
+    const vision::Detection& d = s.detection;
+    CameraView::Seen seen;
+    seen.box =
+        cv::Rect2d(d.box.x * scale, d.box.y * scale, d.box.width * scale, d.box.height * scale);
+    seen.kind = d.kind;
+    seen.colour = d.colour;
+    if (d.measurement) seen.range_m = d.measurement->range_m;
+    seen.use = s.use;
+    view.seen.push_back(std::move(seen));
+  }
+  return view;
 }
 
 mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::RobotConfig& robot,
@@ -223,7 +247,13 @@ void MatchWorld::MaybeSnapshot(bool force) {
   s.tracked = Belief().objects;
   s.action = action_label_;
   s.points = Points().value_or(0);
+  s.camera = camera_view_;
   snapshots_.push_back(std::move(s));
+}
+
+void MatchWorld::KeepView(const platform::RgbdFrame& frame, const mapping::ObjectFrame& objects) {
+  if (setup_.snapshot_period_s <= 0.0) return;  // no replay: nothing to keep
+  camera_view_ = std::make_shared<const CameraView>(MakeCameraView(frame, objects, now_s()));
 }
 
 bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
@@ -283,7 +313,7 @@ int MatchWorld::Observe(int max_frames) {
     const mapping::LandmarkFrame update = slam_.UpdateLandmarks(rgbd);
     // Objects on the first frame and the last: two sightings confirm an object, so a single
     // stop can map what it sees; a false detection rarely survives both.
-    if (taken == 0) slam_.TrackObjects(rgbd, now_s());
+    if (taken == 0) KeepView(rgbd, slam_.TrackObjects(rgbd, now_s()));
     last_tracked = taken == 0;
     ++taken;
     ++frames_;
@@ -293,7 +323,7 @@ int MatchWorld::Observe(int max_frames) {
     if (!update.more_frames) break;
   }
   if (taken == 0) return 0;
-  if (!last_tracked) slam_.TrackObjects(rgbd, now_s());
+  if (!last_tracked) KeepView(rgbd, slam_.TrackObjects(rgbd, now_s()));
   UpdateMaps();
   return taken;
 }

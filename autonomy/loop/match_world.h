@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 #include "autonomy/loop/robot_io.h"
 #include "field_configs/robot_config.h"
@@ -57,6 +58,25 @@ struct MatchSetup {
   bool adaptive_filter = false;  // the EKF's adaptive noise (mapping::AdaptiveOptions)
 };
 
+// What the camera saw on the last frame whose objects were detected (the first and the last
+// frame of every look), downscaled, with those detections: the replay's camera panel. One is
+// made per such frame, only when snapshots are recorded, and shared by the snapshots showing it.
+struct CameraView {
+  double t_s = 0.0;  // when the frame was taken
+  cv::Mat image;     // BGR (CV_8UC3), the colour frame downscaled to kCameraViewWidth
+  struct Seen {
+    cv::Rect2d box;  // in `image`'s pixels
+    std::string kind, colour;
+    double range_m = -1.0;  // < 0: no range
+    mapping::DetectionUse use = mapping::DetectionUse::kTracked;
+  };
+  std::vector<Seen> seen;
+};
+inline constexpr int kCameraViewWidth = 256;
+// The view of `frame` (its colour image) with `objects`, the detections made on it.
+CameraView MakeCameraView(const platform::RgbdFrame& frame, const mapping::ObjectFrame& objects,
+                          double t_s, int width = kCameraViewWidth);
+
 // A moment of the match for the replay and the map picture.
 struct Snapshot {
   double t_s = 0.0;
@@ -73,6 +93,7 @@ struct Snapshot {
   std::vector<strategy::ObjectBelief> tracked;
   std::string action;
   int points = 0;
+  std::shared_ptr<const CameraView> camera;  // the last frame seen; null before the first
 };
 
 // Estimate against truth at the same instant (every filter update), for ATE and the TUM file.
@@ -164,6 +185,8 @@ class MatchWorld {
   void Advance(double dt_s);
   void RecordSample();
   void MaybeSnapshot(bool force = false);
+  // Keeps `frame` and its detections for the replay, when snapshots are recorded.
+  void KeepView(const platform::RgbdFrame& frame, const mapping::ObjectFrame& objects);
   void UpdateMaps();
   void Init(uint64_t seed);
   bool PathClear(const std::vector<Eigen::Vector2d>& path) const;
@@ -188,6 +211,7 @@ class MatchWorld {
   std::vector<int> picked_ids_;  // tracker ids of objects taken off the field
   std::vector<PoseSample> samples_;
   std::vector<Snapshot> snapshots_;
+  std::shared_ptr<const CameraView> camera_view_;  // the last frame seen, for the snapshots
   std::vector<std::vector<Eigen::Vector2d>> paths_;
   std::string action_label_;
   double next_snapshot_s_ = 0.0;

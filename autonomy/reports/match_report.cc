@@ -22,6 +22,7 @@ const cv::Scalar kEstimate(0, 120, 255);        // orange
 const cv::Scalar kPath(200, 120, 0);            // blue
 const cv::Scalar kAttemptInside(40, 160, 40);   // green
 const cv::Scalar kAttemptOutside(30, 30, 220);  // red
+const cv::Scalar kNotUsed(150, 150, 150);       // grey: detections not tracked
 
 cv::Scalar Palette(const field::SeasonConfig& season, const std::string& name) {
   const auto it = season.colours.find(name);
@@ -333,7 +334,65 @@ cv::Mat DrawSnapshot(const MatchResult& r, size_t k) {
   }
   Text(image, "black: truth, orange: estimate", cv::Point(x, y += 30), 0.45);
   Text(image, "x: tracked objects", cv::Point(x, y += 20), 0.45);
-  return image;
+  cv::Mat frame;
+  cv::hconcat(image, DrawCameraPanel(r.field, s, cv::Size(kCameraPanelWidth, image.rows)), frame);
+  return frame;
+}
+
+cv::Mat DrawCameraPanel(const field::SeasonConfig& season, const Snapshot& s, cv::Size size) {
+  cv::Mat panel(size, CV_8UC3, cv::Scalar(250, 250, 250));
+  const int margin = 10, top = 45, legend = 70;
+  const cv::Rect area(margin, top, std::max(1, size.width - 2 * margin),
+                      std::max(1, size.height - top - legend));
+  if (!s.camera || s.camera->image.empty()) {
+    Text(panel, "camera", cv::Point(margin, 30), 0.6);
+    cv::rectangle(panel, area, kNotUsed, 1);
+    Text(panel, "no camera frame taken yet", cv::Point(area.x + 20, area.y + area.height / 2), 0.55,
+         kNotUsed);
+    return panel;
+  }
+  const CameraView& v = *s.camera;
+  int tracked = 0;
+  for (const CameraView::Seen& d : v.seen) tracked += d.use == mapping::DetectionUse::kTracked;
+  Text(panel,
+       "camera at t = " + Fixed(v.t_s, 2) + " s: " + std::to_string(v.seen.size()) +
+           " detections, " + std::to_string(tracked) + " tracked",
+       cv::Point(margin, 30), 0.5);
+  const double f = std::min(static_cast<double>(area.width) / v.image.cols,
+                            static_cast<double>(area.height) / v.image.rows);
+  const cv::Size shown(std::max(1, static_cast<int>(v.image.cols * f)),
+                       std::max(1, static_cast<int>(v.image.rows * f)));
+  cv::Mat scaled;
+  cv::resize(v.image, scaled, shown, 0, 0, cv::INTER_LINEAR);
+  scaled.copyTo(panel(cv::Rect(area.x, area.y, shown.width, shown.height)));
+  for (const CameraView::Seen& d : v.seen) {
+    const bool used = d.use == mapping::DetectionUse::kTracked;
+    const cv::Scalar colour = used ? Palette(season, d.colour) : kNotUsed;
+    const cv::Point tl(area.x + static_cast<int>(std::lround(d.box.x * f)),
+                       area.y + static_cast<int>(std::lround(d.box.y * f)));
+    const cv::Point br(area.x + static_cast<int>(std::lround(d.box.br().x * f)),
+                       area.y + static_cast<int>(std::lround(d.box.br().y * f)));
+    cv::rectangle(panel, tl, br, colour, used ? 2 : 1, cv::LINE_8);
+    std::string label = (d.kind.empty() ? "?" : d.kind) + " " + d.colour + " " +
+                        (d.range_m >= 0.0 ? Fixed(d.range_m, 2) + " m" : "no range");
+    if (d.use == mapping::DetectionUse::kOffField) label += ", off field";
+    // On a strip of the box's colour above the box (below it at the top of the image).
+    int baseline = 0;
+    const cv::Size text = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, &baseline);
+    const int strip_y = tl.y - text.height - 6 >= area.y ? tl.y - text.height - 6 : br.y + 2;
+    // Left of the box's left edge when it would leave the panel on the right.
+    const int strip_x = std::max(0, std::min(tl.x, size.width - text.width - 6));
+    const cv::Rect strip(strip_x, strip_y, text.width + 6, text.height + 6);
+    cv::rectangle(panel, strip & cv::Rect(0, 0, size.width, size.height), colour, cv::FILLED);
+    const bool light = 0.114 * colour[0] + 0.587 * colour[1] + 0.299 * colour[2] > 140.0;
+    Text(panel, label, cv::Point(strip.x + 3, strip.y + text.height + 2), 0.4,
+         light ? cv::Scalar(20, 20, 20) : cv::Scalar(255, 255, 255));
+  }
+  int y = area.y + shown.height + 5;
+  Text(panel, "boxes: detections (kind, colour, range),", cv::Point(margin, y += 20), 0.45);
+  Text(panel, "  grey: not tracked (off field, or no range)", cv::Point(margin, y += 20), 0.45,
+       kNotUsed);
+  return panel;
 }
 
 int WriteReplay(const MatchResult& r, const std::string& path, double speedup) {

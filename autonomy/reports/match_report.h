@@ -27,8 +27,16 @@ void WriteTruthTum(const MatchResult& result, const std::string& path);
 // object estimates against the truth, the planned paths, and a legend with the figures.
 cv::Mat DrawMatchMap(const MatchResult& result);
 
-// One picture of the match at snapshot k (for the replay).
+// One picture of the match at snapshot k (for the replay): the map from above and, on its
+// right, the camera panel (DrawCameraPanel).
 cv::Mat DrawSnapshot(const MatchResult& result, size_t k);
+// What the robot saw at a snapshot, `size` large: its last camera frame (CameraView), scaled
+// to fit below a title, each detection boxed and labelled with its kind, colour and range in
+// the season's colour, those not tracked (dropped by the field gate, or without a range)
+// greyed; before the first frame, a placeholder saying so.
+cv::Mat DrawCameraPanel(const field::SeasonConfig& season, const Snapshot& snapshot, cv::Size size);
+// The camera panel's width in a replay frame.
+inline constexpr int kCameraPanelWidth = 2 * kCameraViewWidth + 20;
 // The replay as a Motion-JPEG AVI (OpenCV's built-in writer), fps frames per match second
 // shown at `speedup` times real time. Returns the frames written; throws on a write failure.
 int WriteReplay(const MatchResult& result, const std::string& path, double speedup = 4.0);
