@@ -229,16 +229,9 @@ void EkfSlam::RecordNis(double nis) {
   for (double v : nis_window_) mean += v;
   mean /= static_cast<double>(nis_window_.size());
   const double upper = Chi2Quantile(0.975, 2 * a.window) / a.window;
-  if (mean > upper) {
-    // Innovations persistently larger than predicted: more process noise.
-    if (!in_episode_) ++counters_.adaptive_episodes;
-    in_episode_ = true;
-    q_scale_ = std::min(a.max_scale, q_scale_ * a.growth);
-  } else if (mean < 2.0 && q_scale_ > 1.0) {
-    // Smaller than expected: back towards the nominal noise.
-    q_scale_ = std::max(1.0, q_scale_ / a.growth);
-    if (q_scale_ == 1.0) in_episode_ = false;
-  }
+  // Innovations persistently larger than predicted: more process noise; smaller than
+  // expected: back towards the nominal noise.
+  StepProcessNoise(mean > upper, mean < 2.0);
   nis_window_.clear();
 }
 
@@ -319,13 +312,18 @@ void EkfSlam::CheckStep() {
     return;  // the pose test used the understated noise too: no verdict on the motion
   }
   if (w.pose_dof == 0) return;
+  // The prediction keeps missing what the measurements say: more process noise.
   const double pose_ratio = w.pose_chi2 / w.pose_dof;
-  if (pose_ratio > Chi2Quantile(0.975, w.pose_dof) / w.pose_dof) {
-    // The prediction keeps missing what the measurements say: more process noise.
+  StepProcessNoise(pose_ratio > Chi2Quantile(0.975, w.pose_dof) / w.pose_dof, pose_ratio < 1.0);
+}
+
+void EkfSlam::StepProcessNoise(bool raise, bool lower) {
+  const AdaptiveOptions& a = options_.adaptive;
+  if (raise) {
     if (!in_episode_) ++counters_.adaptive_episodes;
     in_episode_ = true;
     q_scale_ = std::min(a.max_scale, q_scale_ * a.growth);
-  } else if (pose_ratio < 1.0 && q_scale_ > 1.0) {
+  } else if (lower && q_scale_ > 1.0) {
     q_scale_ = std::max(1.0, q_scale_ / a.growth);
     if (q_scale_ == 1.0) in_episode_ = false;
   }

@@ -209,6 +209,8 @@ class EkfSlam {
   }
   // The sensor-noise check of the step that just ended (AdaptiveOptions), then a new step.
   void CheckStep();
+  // The process-noise scale one step up (`raise`) or back towards 1 (`lower`), episodes counted.
+  void StepProcessNoise(bool raise, bool lower);
   // Widens the pose by `factor` (its rows and columns of P by sqrt(factor)).
   void WidenPose(double factor);
   UpdateOutcome Count(UpdateOutcome outcome);
