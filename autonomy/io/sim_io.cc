@@ -37,10 +37,14 @@ double CalibrateOdometryScale(const field::RobotConfig& robot) {
 
 class SimIo : public RobotIo {
  public:
-  SimIo(field::Alliance alliance, uint64_t seed) : alliance_(alliance), seed_(seed), gyro_(seed) {}
+  SimIo(field::Alliance alliance, uint64_t seed, double jitter_m)
+      : alliance_(alliance), seed_(seed), jitter_m_(jitter_m), gyro_(seed) {}
 
-  void Start(const field::SeasonConfig& field, const field::RobotConfig& robot,
+  void Start(const field::SeasonConfig& season, const field::RobotConfig& robot,
              const Pose2D& start) override {
+    // The simulator and its renderer keep references to the field: it lives here.
+    field_ = PlaceObjects(season, jitter_m_, seed_);
+    const field::SeasonConfig& field = field_;
     robot_ = robot;
     platform::SimFieldOptions options;
     options.preload = true;
@@ -105,6 +109,8 @@ class SimIo : public RobotIo {
 
   field::Alliance alliance_;
   uint64_t seed_;
+  double jitter_m_;
+  field::SeasonConfig field_;  // as placed
   field::RobotConfig robot_;
   platform::SimClock clock_;
   std::unique_ptr<platform::SimField> sim_;
@@ -114,8 +120,9 @@ class SimIo : public RobotIo {
 
 }  // namespace
 
-std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed) {
-  return std::make_unique<SimIo>(alliance, seed);
+std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed,
+                                   double placement_jitter_m) {
+  return std::make_unique<SimIo>(alliance, seed, placement_jitter_m);
 }
 
 field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m,
@@ -165,9 +172,8 @@ MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
                          const field::SeasonConfig& season, const field::RobotConfig& robot,
                          const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
                          const std::function<void(const TimelineEntry&)>& progress) {
-  return RunMatchOn(MakeSimIo(setup.alliance, seed), std::move(strategy),
-                    PlaceObjects(season, setup.placement_jitter_m, seed), robot, setup, seed,
-                    out_dir, progress);
+  return RunMatchOn(MakeSimIo(setup.alliance, seed, setup.placement_jitter_m), std::move(strategy),
+                    season, robot, setup, seed, out_dir, progress);
 }
 
 }  // namespace slamo::autonomy

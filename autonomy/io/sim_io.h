@@ -18,8 +18,12 @@ namespace slamo::autonomy {
 
 // The simulated field of a dry run: SimField (drive base with slip, objects, opponents,
 // intake, scoring), its camera renderer and a yaw gyro, all seeded by `seed`; time on a
-// SimClock, so a dry run goes as fast as the computer allows and replays exactly.
-std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed);
+// SimClock, so a dry run goes as fast as the computer allows and replays exactly. The field
+// given to Start() is the season as its file has it (what the robot is told); the simulator
+// places its objects from it for `seed` (PlaceObjects with placement_jitter_m), and only the
+// simulator knows where they went.
+std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed,
+                                   double placement_jitter_m = 0.0);
 
 // The season with its fixed-position floor objects moved uniformly up to jitter_m (clear of
 // walls and structures), so no two seeds share a layout; preloads (objects on a starting
@@ -27,7 +31,8 @@ std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed);
 field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m, uint64_t seed);
 
 // A dry run: one autonomous period on the simulated field (MakeSimIo), its objects placed for
-// `seed` (PlaceObjects with setup.placement_jitter_m). `progress` (optional) hears each action
+// `seed` (PlaceObjects with setup.placement_jitter_m); the robot and its strategy know only
+// `season` as its file has it. `progress` (optional) hears each action
 // as it starts. When out_dir is set, the OctoMap object map is written there as objects.bt.
 MatchResult RunMatch(const field::SeasonConfig& season, const field::RobotConfig& robot,
                      const MatchSetup& setup, uint64_t seed, const std::string& out_dir = "",

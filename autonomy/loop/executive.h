@@ -83,7 +83,7 @@ struct MatchResult {
   std::vector<std::vector<Eigen::Vector2d>> paths;
   std::vector<Eigen::Vector2d> landmark_estimates, landmark_truth;
   std::vector<Eigen::Matrix2d> landmark_covariances;
-  field::SeasonConfig field;  // the season as placed for this seed
+  field::SeasonConfig field;  // the season the robot was given (its file, not the placement)
 };
 
 // One autonomous period on `io` (the robot: autonomy/hardware_io.h), with the season's objects

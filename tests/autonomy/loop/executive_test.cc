@@ -2,6 +2,8 @@
 #include "autonomy/loop/executive.h"
 #include "autonomy/io/sim_io.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -104,6 +106,34 @@ TEST(Executive, PoseConsistencyCountsTheBandConservativeAndOverconfident) {
   EXPECT_DOUBLE_EQ(c.HonestFraction(), 0.75);
   EXPECT_NEAR(c.band_low, 0.216, 1e-3);
   EXPECT_NEAR(c.band_high, 9.348, 1e-3);
+}
+
+// The robot and its strategy are told the season as its file has it; only the simulator
+// knows where this seed's jitter put the objects (the scripted route plans from the nominal
+// spots, as a team's would).
+TEST(Executive, TheRobotIsToldTheSeasonFileNotThePlacement) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  MatchSetup setup;
+  setup.strategy = "scripted";
+  setup.placement_jitter_m = 0.15;
+  const MatchResult r = RunMatch(season, robot, setup, 2);
+  ASSERT_EQ(r.field.objects.size(), season.objects.size());
+  for (size_t i = 0; i < season.objects.size(); ++i) {
+    if (!season.objects[i].position_m) continue;
+    EXPECT_EQ(r.field.objects[i].position_m->x, season.objects[i].position_m->x) << i;
+    EXPECT_EQ(r.field.objects[i].position_m->y, season.objects[i].position_m->y) << i;
+  }
+  // ... while the simulator moved them: the first object's true spot is not its file's.
+  const field::SeasonConfig placed = PlaceObjects(season, 0.15, 2);
+  double moved = 0.0;
+  for (size_t i = 0; i < season.objects.size(); ++i) {
+    if (!season.objects[i].position_m) continue;
+    moved = std::max(moved,
+                     std::hypot(placed.objects[i].position_m->x - season.objects[i].position_m->x,
+                                placed.objects[i].position_m->y - season.objects[i].position_m->y));
+  }
+  EXPECT_GT(moved, 0.05);
 }
 
 // A strategy that always asks to drive far away, claiming the drive takes `claimed_s`.
