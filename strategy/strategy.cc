@@ -360,6 +360,8 @@ class Base : public Strategy {
     if (cycle.object) {
       a.kind = ActionKind::kPick;
       a.object_id = cycle.object->id;
+      a.object_kind = cycle.object->kind;
+      a.object_colour = cycle.object->colour;
       a.target =
           Eigen::Vector3d(cycle.object->position_m.x(), cycle.object->position_m.y(), stage.z());
       a.frames = 0;
@@ -744,6 +746,8 @@ class ScriptedStrategy : public Base {
       Action pick;
       pick.kind = ActionKind::kPick;
       pick.object_id = o.id;
+      pick.object_kind = o.kind;
+      pick.object_colour = o.colour;
       pick.target = Eigen::Vector3d(o.position_m.x(), o.position_m.y(), cycle.pick_stage.z());
       pick.expected_s = ApproachSeconds(c) + options_.pick_s;
       pick.why = "script: pick";

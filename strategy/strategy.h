@@ -81,7 +81,11 @@ struct Action {
   // kNavigate: a push, driven straight into object_id to knock it off the raised structure it
   // lies on (a large ball off the Toss Up barrier) into the zone beyond.
   bool push = false;
-  int object_id = -1;            // kPick
+  int object_id = -1;  // kPick
+  // kPick: the target's kind and colour (also where object_id names no tracked object: the
+  // scripted route's nominal objects). For the record only: the executive takes what the
+  // intake reports.
+  std::string object_kind, object_colour;
   int goal_index = -1;           // kScore: into SeasonConfig::goals
   double expected_s = 0.0;       // the strategy's estimate of the action's duration
   double expected_points = 0.0;  // expected points of the sequence this action starts

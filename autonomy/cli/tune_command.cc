@@ -44,7 +44,9 @@ int Report(const std::vector<MatchOutcome>& outcomes, const std::string& dir) {
   PrintSummaryTable(rows, std::cout);
   if (!WriteText(dir + "/tune.csv", SummaryCsv(rows))) return 1;
   if (!WriteText(dir + "/tune.json", SummaryJson(rows, outcomes).dump(2) + "\n")) return 1;
-  std::cout << "wrote " << dir << "/tune.csv and " << dir << "/tune.json\n";
+  if (!WriteText(dir + "/attempts.csv", AttemptsCsv(outcomes))) return 1;
+  std::cout << "wrote " << dir << "/tune.csv, " << dir << "/tune.json and " << dir
+            << "/attempts.csv (every pick and score attempt)\n";
   return 0;
 }
 

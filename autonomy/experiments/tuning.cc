@@ -12,6 +12,7 @@
 
 #include "autonomy/io/sim_io.h"
 #include "autonomy/loop/executive.h"
+#include "autonomy/reports/match_report.h"
 #include "planning/planner.h"
 #include "strategy/strategy.h"
 
@@ -160,6 +161,8 @@ std::string Describe(const ParamSet& params) {
 }
 
 nlohmann::json ToJson(const MatchOutcome& o) {
+  nlohmann::json records = nlohmann::json::array();
+  for (const AttemptCheck& a : o.records) records.push_back(AttemptJson(a));
   return {{"combo", o.combo},
           {"seed", o.seed},
           {"points", o.points},
@@ -171,6 +174,7 @@ nlohmann::json ToJson(const MatchOutcome& o) {
           {"nees_honest", o.nees_honest},
           {"attempts", o.attempts},
           {"attempts_inside", o.attempts_inside},
+          {"records", records},
           {"duration_s", o.duration_s},
           {"wall_s", o.wall_s},
           {"failed", o.failed},
@@ -190,6 +194,9 @@ MatchOutcome OutcomeFromJson(const nlohmann::json& j) {
   o.nees_honest = j.value("nees_honest", 0);
   o.attempts = j.value("attempts", 0);
   o.attempts_inside = j.value("attempts_inside", 0);
+  if (j.contains("records")) {
+    for (const nlohmann::json& a : j.at("records")) o.records.push_back(AttemptFromJson(a));
+  }
   o.duration_s = j.at("duration_s").get<double>();
   o.wall_s = j.at("wall_s").get<double>();
   o.failed = j.at("failed").get<bool>();
@@ -236,6 +243,7 @@ std::vector<MatchOutcome> RunTasks(const field::SeasonConfig& season,
         o.nees_honest = r.consistency.in_band + r.consistency.below;
         o.attempts = static_cast<int>(r.attempts.size());
         for (const AttemptCheck& a : r.attempts) o.attempts_inside += a.Inside();
+        o.records = r.attempts;
         o.duration_s = r.duration_s;
         o.wall_s = r.wall_s;
       } catch (const std::exception& e) {
@@ -301,6 +309,7 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
     s.combo = combo;
     std::vector<double> points, gained;
     int updates = 0, honest = 0, attempts = 0, inside = 0;
+    int pick_target = 0, pick_other = 0, pick_nothing = 0, scored = 0;
     for (const MatchOutcome* o : by_combo[combo]) {
       if (o->failed) {
         ++s.failed;
@@ -314,6 +323,17 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
       s.mean_ate_m += o->pose_ate_m;
       updates += o->nees_updates, honest += o->nees_honest;
       attempts += o->attempts, inside += o->attempts_inside;
+      for (const AttemptCheck& a : o->records) {
+        if (a.action == "PICK") {
+          ++s.picks;
+          pick_target += a.outcome == "target";
+          pick_other += a.outcome == "other";
+          pick_nothing += a.outcome == "nothing";
+        } else if (a.action == "SCORE") {
+          ++s.releases;
+          scored += a.outcome == "scored";
+        }
+      }
       s.mean_wall_s += o->wall_s;
     }
     const auto mean_ci = [](const std::vector<double>& v, double* mean, double* ci) {
@@ -329,6 +349,11 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     s.nees_honest_fraction = updates ? static_cast<double>(honest) / updates : nan;
     s.attempts_inside_fraction = attempts ? static_cast<double>(inside) / attempts : nan;
+    const auto fraction = [&](int n, int of) { return of ? static_cast<double>(n) / of : nan; };
+    s.pick_target_fraction = fraction(pick_target, s.picks);
+    s.pick_other_fraction = fraction(pick_other, s.picks);
+    s.pick_nothing_fraction = fraction(pick_nothing, s.picks);
+    s.release_scored_fraction = fraction(scored, s.releases);
     mean_ci(points, &s.mean_points, &s.ci95_points);
     mean_ci(gained, &s.mean_gained, &s.ci95_gained);
     if (s.matches > 0) {
@@ -348,14 +373,16 @@ std::string SummaryCsv(const std::vector<ComboSummary>& rows) {
   std::ostringstream out;
   out << "rank,combo,matches,failed,mean_points,ci95_points,mean_gained,ci95_gained,overruns,mean_"
          "overrun_s,"
-         "mean_ate_m,nees_honest_fraction,attempts_inside_fraction,mean_wall_s\n";
+         "mean_ate_m,nees_honest_fraction,attempts_inside_fraction,picks,pick_target_fraction,"
+         "pick_other_fraction,pick_nothing_fraction,releases,release_scored_fraction,mean_wall_s\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
     out << ++rank << ",\"" << r.combo << "\"," << r.matches << ',' << r.failed << ','
         << r.mean_points << ',' << r.ci95_points << ',' << r.mean_gained << ',' << r.ci95_gained
         << ',' << r.overruns << ',' << r.mean_overrun_s << ',' << r.mean_ate_m << ','
-        << r.nees_honest_fraction << ',' << r.attempts_inside_fraction << ',' << r.mean_wall_s
-        << '\n';
+        << r.nees_honest_fraction << ',' << r.attempts_inside_fraction << ',' << r.picks << ','
+        << r.pick_target_fraction << ',' << r.pick_other_fraction << ',' << r.pick_nothing_fraction
+        << ',' << r.releases << ',' << r.release_scored_fraction << ',' << r.mean_wall_s << '\n';
   }
   return out.str();
 }
@@ -377,6 +404,12 @@ nlohmann::json SummaryJson(const std::vector<ComboSummary>& rows,
                             {"mean_ate_m", r.mean_ate_m},
                             {"nees_honest_fraction", r.nees_honest_fraction},
                             {"attempts_inside_fraction", r.attempts_inside_fraction},
+                            {"picks", r.picks},
+                            {"pick_target_fraction", r.pick_target_fraction},
+                            {"pick_other_fraction", r.pick_other_fraction},
+                            {"pick_nothing_fraction", r.pick_nothing_fraction},
+                            {"releases", r.releases},
+                            {"release_scored_fraction", r.release_scored_fraction},
                             {"mean_wall_s", r.mean_wall_s}});
   }
   j["matches"] = nlohmann::json::array();
@@ -388,7 +421,9 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
   out << std::left << std::setw(5) << "rank" << std::setw(40) << "parameters" << std::right
       << std::setw(8) << "matches" << std::setw(18) << "points (95% CI)" << std::setw(18)
       << "gained (95% CI)" << std::setw(10) << "overruns" << std::setw(10) << "ATE m"
-      << std::setw(10) << "NEES ok" << std::setw(10) << "in 3sig" << std::setw(10) << "wall s"
+      << std::setw(10) << "NEES ok" << std::setw(10) << "in 3sig" << std::setw(7) << "picks"
+      << std::setw(8) << "target" << std::setw(8) << "other" << std::setw(8) << "nothing"
+      << std::setw(7) << "rels" << std::setw(8) << "scored" << std::setw(10) << "wall s"
       << "\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
@@ -399,10 +434,29 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
         << std::setw(8) << r.matches << std::setw(18) << points.str() << std::setw(18)
         << gained.str() << std::setw(10) << r.overruns << std::setw(10) << std::fixed
         << std::setprecision(3) << r.mean_ate_m << std::setw(10) << std::setprecision(3)
-        << r.nees_honest_fraction << std::setw(10) << r.attempts_inside_fraction << std::setw(10)
-        << std::setprecision(2) << r.mean_wall_s << "\n";
+        << r.nees_honest_fraction << std::setw(10) << r.attempts_inside_fraction << std::setw(7)
+        << r.picks << std::setprecision(2) << std::setw(8) << r.pick_target_fraction << std::setw(8)
+        << r.pick_other_fraction << std::setw(8) << r.pick_nothing_fraction << std::setw(7)
+        << r.releases << std::setw(8) << r.release_scored_fraction << std::setw(10) << r.mean_wall_s
+        << "\n";
     if (r.failed) out << "     (" << r.failed << " matches failed: see tune.json)\n";
   }
+}
+
+std::string AttemptsCsv(const std::vector<MatchOutcome>& outcomes) {
+  std::ostringstream out;
+  out << "combo,seed,t_s,action,kind,colour,goal_index,range_m,bearing_deg,sigma_m,error_m,"
+         "target_error_m,outcome\n";
+  out << std::setprecision(6);
+  for (const MatchOutcome& o : outcomes) {
+    for (const AttemptCheck& a : o.records) {
+      out << '"' << o.combo << "\"," << o.seed << ',' << a.t_s << ',' << a.action << ',' << a.kind
+          << ',' << a.colour << ',' << a.goal_index << ',' << a.range_m << ','
+          << a.bearing_rad * 180.0 / M_PI << ',' << a.three_sigma_m / 3.0 << ',' << a.error_m << ','
+          << a.target_error_m << ',' << a.outcome << '\n';
+    }
+  }
+  return out.str();
 }
 
 }  // namespace slamo::autonomy

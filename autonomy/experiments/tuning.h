@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "autonomy/loop/executive.h"
 #include "autonomy/loop/match_world.h"
 #include "field_configs/robot_config.h"
 #include "field_configs/season_config.h"
@@ -42,6 +43,9 @@ struct MatchOutcome {
   double pose_ate_m = 0.0;
   int nees_updates = 0, nees_honest = 0;  // filter updates; NEES in its band or below
   int attempts = 0, attempts_inside = 0;  // picks/scores; true error inside the 3-sigma
+  // Every pick and score attempt, judged on the simulator (AttemptCheck::outcome): the
+  // records `tune calibrate` fits its success models to.
+  std::vector<AttemptCheck> records;
   double duration_s = 0.0;
   double wall_s = 0.0;
   bool failed = false;  // the match process crashed or threw
@@ -75,6 +79,11 @@ struct ComboSummary {
   double mean_ate_m = 0.0;
   double nees_honest_fraction = 0.0;      // over all updates: NEES in its band or below
   double attempts_inside_fraction = 0.0;  // over all picks/scores: error inside 3-sigma
+  // Picks that took their target, another object, nothing; releases that scored in the goal
+  // aimed at (fractions of the attempts; NaN: none).
+  int picks = 0, releases = 0;
+  double pick_target_fraction = 0.0, pick_other_fraction = 0.0, pick_nothing_fraction = 0.0;
+  double release_scored_fraction = 0.0;
   double mean_wall_s = 0.0;
 };
 // Per combination, ranked by mean points (best first).
@@ -83,5 +92,8 @@ std::string SummaryCsv(const std::vector<ComboSummary>& rows);
 nlohmann::json SummaryJson(const std::vector<ComboSummary>& rows,
                            const std::vector<MatchOutcome>& outcomes);
 void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out);
+// Every attempt of every match, one row each (combo, seed, action, kind, colour, goal,
+// range_m, bearing_deg, sigma_m, error_m, target_error_m, outcome): attempts.csv.
+std::string AttemptsCsv(const std::vector<MatchOutcome>& outcomes);
 
 }  // namespace slamo::autonomy

@@ -22,13 +22,16 @@ namespace {
 
 using strategy::ActionKind;
 
-// The robot's true position error and the filter's 3-sigma now; none without the truth.
-std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const std::string& action) {
+// The robot's true position error and the filter's 3-sigma now, and what `action` aims at
+// from where; none without the truth.
+std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const strategy::Action& action,
+                                         const strategy::Belief& belief) {
   const std::optional<platform::Pose2D> truth = world.io().TruePose();
-  if (!truth) return std::nullopt;
+  const std::optional<std::vector<TrueObject>> objects = world.io().TrueObjects();
+  if (!truth || !objects) return std::nullopt;
   AttemptCheck c;
   c.t_s = world.now_s();
-  c.action = action;
+  c.action = strategy::ActionName(action.kind);
   c.estimate_m = world.slam().pose().head<2>();
   c.truth_m = Eigen::Vector2d(truth->x_m, truth->y_m);
   c.error_m = (c.estimate_m - c.truth_m).norm();
@@ -37,7 +40,58 @@ std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const std::str
       3.0 *
       std::sqrt(std::max(
           0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position).eigenvalues().maxCoeff()));
+
+  Eigen::Vector2d aim = action.target.head<2>();
+  if (action.kind == ActionKind::kPick) {
+    c.kind = action.object_kind, c.colour = action.object_colour;
+    for (const strategy::ObjectBelief& o : belief.objects) {
+      if (o.id == action.object_id) aim = o.position_m, c.kind = o.kind, c.colour = o.colour;
+    }
+    double best = kTargetMatch_m;
+    for (const TrueObject& t : *objects) {
+      if (t.held || t.in_goal >= 0) continue;
+      if (!c.kind.empty() && (t.kind != c.kind || t.colour != c.colour)) continue;
+      const double e = (t.center_m.head<2>() - aim).norm();
+      if (e < best) best = e, c.target_truth_id = t.id, c.target_error_m = e;
+    }
+  } else {
+    c.goal_index = action.goal_index;
+    if (belief.held) c.kind = belief.held->kind, c.colour = belief.held->colour;
+    const field::SeasonConfig& season = world.field();
+    if (action.goal_index >= 0 && action.goal_index < static_cast<int>(season.goals.size())) {
+      const field::Goal& goal = season.goals[action.goal_index];
+      aim = Eigen::Vector2d(goal.center_m.x, goal.center_m.y);
+    }
+  }
+  c.aim_m = aim;
+  const Eigen::Vector3d pose = world.slam().pose();
+  const Eigen::Vector2d d = aim - pose.head<2>();
+  c.range_m = d.norm();
+  c.bearing_rad = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - pose.z());
   return c;
+}
+
+// What came of the attempt, from the simulator's objects before and after it.
+void JudgeAttempt(const std::vector<TrueObject>& before, const std::vector<TrueObject>& after,
+                  AttemptCheck* c) {
+  std::vector<int> taken, released;
+  for (const TrueObject& b : before) {
+    for (const TrueObject& a : after) {
+      if (a.id != b.id) continue;
+      if (!b.held && a.held) taken.push_back(a.id);
+      if (b.held && !a.held) released.push_back(a.id);
+    }
+  }
+  if (c->action == "PICK") {
+    if (taken.empty())
+      c->outcome = "nothing";
+    else
+      c->outcome = std::find(taken.begin(), taken.end(), c->target_truth_id) != taken.end()
+                       ? "target"
+                       : "other";
+  } else {
+    c->outcome = released.empty() ? "nothing" : c->ok ? "scored" : "missed";
+  }
 }
 
 // Tracked objects against where the objects really are at the end.
@@ -68,6 +122,15 @@ std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
 }
 
 }  // namespace
+
+const std::vector<std::string>& PickOutcomes() {
+  static const std::vector<std::string> names = {"target", "other", "nothing"};
+  return names;
+}
+const std::vector<std::string>& ScoreOutcomes() {
+  static const std::vector<std::string> names = {"scored", "missed", "nothing"};
+  return names;
+}
 
 namespace {
 
@@ -160,8 +223,11 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
     //    reaches it (DriveControllerOptions::hard_deadline_s), whatever the action.
     world.set_action_label(entry.action + " " + action.why);
     std::optional<AttemptCheck> attempt;
-    if (action.kind == ActionKind::kPick || action.kind == ActionKind::kScore)
-      attempt = CheckAttempt(world, entry.action);
+    std::optional<std::vector<TrueObject>> objects_before;
+    if (action.kind == ActionKind::kPick || action.kind == ActionKind::kScore) {
+      attempt = CheckAttempt(world, action, belief);
+      objects_before = world.io().TrueObjects();
+    }
     bool ok = false;
     switch (action.kind) {
       case ActionKind::kObserve:
@@ -191,6 +257,8 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
     strategy->Feedback(action, ok);
     if (attempt) {
       attempt->ok = ok;
+      const std::optional<std::vector<TrueObject>> objects_after = world.io().TrueObjects();
+      if (objects_before && objects_after) JudgeAttempt(*objects_before, *objects_after, &*attempt);
       result.attempts.push_back(*attempt);
     }
     entry.ok = ok;

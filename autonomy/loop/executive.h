@@ -39,7 +39,8 @@ struct ObjectReport {
 };
 
 // A pick or score attempt against the truth, when it began: the robot's position error and the
-// filter's 3-sigma (three times the position covariance's longest axis).
+// filter's 3-sigma (three times the position covariance's longest axis); what was aimed at,
+// from where; and what came of it, judged on the simulator's objects.
 struct AttemptCheck {
   double t_s = 0.0;
   std::string action;  // PICK or SCORE
@@ -49,7 +50,28 @@ struct AttemptCheck {
   double error_m = 0.0;
   double three_sigma_m = 0.0;
   bool Inside() const { return error_m <= three_sigma_m; }
+
+  // PICK: the target's kind and colour (empty: any); SCORE: the held object's, and the goal.
+  std::string kind, colour;
+  int goal_index = -1;
+  // From the estimated pose when the attempt began, to the believed target (PICK) or the
+  // goal's centre (SCORE): distance, and bearing off the robot's heading (the turn of the
+  // approach, rad).
+  Eigen::Vector2d aim_m = Eigen::Vector2d::Zero();
+  double range_m = 0.0;
+  double bearing_rad = 0.0;
+  // PICK: the true object the belief stood for (the nearest of its kind and colour within
+  // kTargetMatch_m), and how far the belief was from it; -1 when there was none.
+  int target_truth_id = -1;
+  double target_error_m = -1.0;
+  // PICK: "target" (the intake took that object), "other" (it took another), "nothing".
+  // SCORE: "scored" (in the goal aimed at), "missed" (released elsewhere), "nothing" (nothing
+  // left the intake).
+  std::string outcome;
 };
+inline constexpr double kTargetMatch_m = 0.5;
+const std::vector<std::string>& PickOutcomes();   // target, other, nothing
+const std::vector<std::string>& ScoreOutcomes();  // scored, missed, nothing
 
 struct MatchResult {
   std::string robot_io;                 // what the match ran on (RobotIo::Describe)

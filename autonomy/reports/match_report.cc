@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
@@ -84,6 +85,47 @@ FieldCanvas BaseCanvas(const MatchResult& result, double px_per_m) {
 
 }  // namespace
 
+nlohmann::json AttemptJson(const AttemptCheck& a) {
+  return {{"t_s", a.t_s},
+          {"action", a.action},
+          {"ok", a.ok},
+          {"estimate_m", {a.estimate_m.x(), a.estimate_m.y()}},
+          {"truth_m", {a.truth_m.x(), a.truth_m.y()}},
+          {"error_m", a.error_m},
+          {"three_sigma_m", a.three_sigma_m},
+          {"inside_three_sigma", a.Inside()},
+          {"kind", a.kind},
+          {"colour", a.colour},
+          {"goal_index", a.goal_index},
+          {"aim_m", {a.aim_m.x(), a.aim_m.y()}},
+          {"range_m", a.range_m},
+          {"bearing_rad", a.bearing_rad},
+          {"target_truth_id", a.target_truth_id},
+          {"target_error_m", a.target_error_m},
+          {"outcome", a.outcome}};
+}
+
+AttemptCheck AttemptFromJson(const nlohmann::json& j) {
+  AttemptCheck a;
+  a.t_s = j.at("t_s").get<double>();
+  a.action = j.at("action").get<std::string>();
+  a.ok = j.at("ok").get<bool>();
+  a.estimate_m = {j.at("estimate_m").at(0).get<double>(), j.at("estimate_m").at(1).get<double>()};
+  a.truth_m = {j.at("truth_m").at(0).get<double>(), j.at("truth_m").at(1).get<double>()};
+  a.error_m = j.at("error_m").get<double>();
+  a.three_sigma_m = j.at("three_sigma_m").get<double>();
+  a.kind = j.at("kind").get<std::string>();
+  a.colour = j.at("colour").get<std::string>();
+  a.goal_index = j.at("goal_index").get<int>();
+  a.aim_m = {j.at("aim_m").at(0).get<double>(), j.at("aim_m").at(1).get<double>()};
+  a.range_m = j.at("range_m").get<double>();
+  a.bearing_rad = j.at("bearing_rad").get<double>();
+  a.target_truth_id = j.at("target_truth_id").get<int>();
+  a.target_error_m = j.at("target_error_m").get<double>();
+  a.outcome = j.at("outcome").get<std::string>();
+  return a;
+}
+
 nlohmann::json ReportJson(const MatchResult& r) {
   nlohmann::json j;
   j["season"] = r.season;
@@ -133,12 +175,7 @@ nlohmann::json ReportJson(const MatchResult& r) {
     int inside = 0;
     for (const AttemptCheck& a : r.attempts) {
       inside += a.Inside();
-      j["attempts"].push_back({{"t_s", a.t_s},
-                               {"action", a.action},
-                               {"ok", a.ok},
-                               {"error_m", a.error_m},
-                               {"three_sigma_m", a.three_sigma_m},
-                               {"inside_three_sigma", a.Inside()}});
+      j["attempts"].push_back(AttemptJson(a));
     }
     j["attempts_inside_three_sigma"] = inside;
   }
@@ -435,6 +472,19 @@ void PrintSummary(const MatchResult& r, std::ostream& out) {
         << " updates, below (conservative) " << c.below << ", above (overconfident) " << c.above
         << "; picks/scores with the true error inside 3-sigma: " << inside << " of "
         << r.attempts.size() << "\n";
+  }
+  if (!r.attempts.empty()) {
+    std::map<std::string, int> picks, scores;
+    int n_picks = 0, n_scores = 0;
+    for (const AttemptCheck& a : r.attempts) {
+      if (a.action == "PICK") ++picks[a.outcome], ++n_picks;
+      if (a.action == "SCORE") ++scores[a.outcome], ++n_scores;
+    }
+    out << "  picks           " << n_picks;
+    for (const std::string& k : PickOutcomes()) out << ", " << k << " " << picks[k];
+    out << "; releases " << n_scores;
+    for (const std::string& k : ScoreOutcomes()) out << ", " << k << " " << scores[k];
+    out << "\n";
   }
   int matched = 0;
   double sum = 0.0;

@@ -17,6 +17,9 @@ namespace slamo::autonomy {
 // objects [{class, est_x, est_y, true_x, true_y, error_m}], timeline [{t_s, action, ...}] and
 // the time split.
 nlohmann::json ReportJson(const MatchResult& result);
+// One pick or score attempt as report.json and tune.json keep it, and back.
+nlohmann::json AttemptJson(const AttemptCheck& attempt);
+AttemptCheck AttemptFromJson(const nlohmann::json& j);
 
 // The estimated trajectory in TUM format (t x y z qx qy qz qw), one line per filter update.
 void WriteTum(const MatchResult& result, const std::string& path);

@@ -1,5 +1,7 @@
 #include "autonomy/experiments/tuning.h"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 namespace slamo::autonomy {
@@ -63,6 +65,40 @@ TEST(Tuning, SummaryRanksByMeanPointsWithConfidenceIntervals) {
   // sd of {0,1,2,3} = 1.291; 1.96 * 1.291 / 2
   EXPECT_NEAR(rows[1].ci95_gained, 1.96 * 1.2909944 / 2.0, 1e-6);
   EXPECT_NE(SummaryCsv(rows).find("rank,combo"), std::string::npos);
+}
+
+// Pick and release rates per combination from the attempt records, which survive the trip
+// through JSON (a tune shard, or the pipe from a match process) and end up in attempts.csv.
+TEST(Tuning, PickAndReleaseRatesComeFromTheAttemptRecords) {
+  const auto attempt = [](const std::string& action, const std::string& outcome) {
+    AttemptCheck a;
+    a.action = action;
+    a.outcome = outcome;
+    a.kind = "buckyball";
+    a.colour = "red";
+    a.range_m = 0.7;
+    a.three_sigma_m = 0.09;
+    return a;
+  };
+  MatchOutcome m;
+  m.combo = "strategy=planner";
+  m.records = {attempt("PICK", "target"),  attempt("PICK", "target"),  attempt("PICK", "other"),
+               attempt("PICK", "nothing"), attempt("SCORE", "scored"), attempt("SCORE", "missed")};
+  const MatchOutcome back = OutcomeFromJson(nlohmann::json::parse(ToJson(m).dump()));
+  ASSERT_EQ(back.records.size(), m.records.size());
+  EXPECT_EQ(back.records[2].outcome, "other");
+  EXPECT_DOUBLE_EQ(back.records[0].range_m, 0.7);
+  const std::vector<ComboSummary> rows = Summarise({back});
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].picks, 4);
+  EXPECT_DOUBLE_EQ(rows[0].pick_target_fraction, 0.5);
+  EXPECT_DOUBLE_EQ(rows[0].pick_other_fraction, 0.25);
+  EXPECT_DOUBLE_EQ(rows[0].pick_nothing_fraction, 0.25);
+  EXPECT_EQ(rows[0].releases, 2);
+  EXPECT_DOUBLE_EQ(rows[0].release_scored_fraction, 0.5);
+  const std::string csv = AttemptsCsv({back});
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);  // the header and six attempts
+  EXPECT_NE(csv.find("PICK,buckyball,red,-1,0.7,0,0.03,"), std::string::npos) << csv;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "autonomy/reports/match_report.h"
 #include "field_configs/loader.h"
+#include "platform/field_geometry.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -74,6 +75,24 @@ TEST(Executive, FullDryRunScoresWithinTheDeadlineAndMapsItsObjects) {
     EXPECT_EQ(a["inside_three_sigma"].get<bool>(),
               a["error_m"].get<double>() <= a["three_sigma_m"].get<double>());
     EXPECT_GT(a["three_sigma_m"].get<double>(), 0.0);
+    // Judged on the simulator's objects: a pick that took its target reported success, one
+    // that took nothing did not; a release scored exactly when it reported so.
+    const std::string outcome = a["outcome"].get<std::string>();
+    const bool ok = a["ok"].get<bool>();
+    if (a["action"] == "PICK") {
+      EXPECT_NE(std::find(PickOutcomes().begin(), PickOutcomes().end(), outcome),
+                PickOutcomes().end())
+          << outcome;
+      if (outcome == "target") {
+        EXPECT_TRUE(ok);
+      }
+      if (outcome == "nothing") {
+        EXPECT_FALSE(ok);
+      }
+    } else {
+      EXPECT_EQ(outcome == "scored", ok) << outcome;
+    }
+    EXPECT_GT(a["range_m"].get<double>(), 0.0);
   }
   WriteTum(r, dir + "/trajectory.tum");
   std::ifstream tum(dir + "/trajectory.tum");
@@ -106,6 +125,72 @@ TEST(Executive, PoseConsistencyCountsTheBandConservativeAndOverconfident) {
   EXPECT_DOUBLE_EQ(c.HonestFraction(), 0.75);
   EXPECT_NEAR(c.band_low, 0.216, 1e-3);
   EXPECT_NEAR(c.band_high, 9.348, 1e-3);
+}
+
+// One pick at `aim`, aimed at an object of `kind` (red), then nothing.
+class PickOnce : public strategy::Strategy {
+ public:
+  PickOnce(Eigen::Vector2d aim, std::string kind) : aim_(aim), kind_(std::move(kind)) {}
+  std::string name() const override { return "pick-once"; }
+  bool perceives() const override { return false; }
+  strategy::Action Next(const strategy::Belief&, const strategy::StrategyContext&) override {
+    strategy::Action a;
+    if (done_) return a;
+    done_ = true;
+    a.kind = strategy::ActionKind::kPick;
+    a.target = Eigen::Vector3d(aim_.x(), aim_.y(), 0.0);
+    a.object_kind = kind_;
+    a.object_colour = "red";
+    a.expected_s = 4.0;
+    return a;
+  }
+  void Feedback(const strategy::Action&, bool) override {}
+
+ private:
+  Eigen::Vector2d aim_;
+  std::string kind_;
+  bool done_ = false;
+};
+
+// What a pick took, judged on the simulator's objects: the object the strategy aimed at,
+// another one, or nothing. The field holds one red buckyball 0.8 m ahead of the start (or
+// none), and the robot, preload-free, picks there once.
+TEST(Executive, APickIsJudgedByTheObjectTheIntakeTook) {
+  field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  season.rules.autonomous_s = 10.0;
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  const platform::Pose2D start = platform::StartPose(season, field::Alliance::kRed, 0);
+  const Eigen::Vector2d ahead(start.x_m + 0.8 * std::cos(start.theta_rad),
+                              start.y_m + 0.8 * std::sin(start.theta_rad));
+  field::ObjectPlacement ball;
+  ball.type = "buckyball";
+  ball.colour = "red";
+  ball.position_m = field::Vec2{ahead.x(), ahead.y()};
+  MatchSetup setup;
+  setup.placement_jitter_m = 0.0;
+  const auto pick = [&](bool with_ball, const std::string& kind) {
+    field::SeasonConfig s = season;
+    s.objects.clear();
+    if (with_ball) s.objects.push_back(ball);
+    const MatchResult r = RunMatchWith(std::make_unique<PickOnce>(ahead, kind), s, robot, setup, 1);
+    EXPECT_EQ(r.attempts.size(), 1u);
+    return r.attempts.empty() ? AttemptCheck{} : r.attempts.front();
+  };
+  const AttemptCheck target = pick(true, "buckyball");
+  EXPECT_EQ(target.outcome, "target");
+  EXPECT_TRUE(target.ok);
+  EXPECT_GE(target.target_truth_id, 1);
+  EXPECT_LT(target.target_error_m, 1e-9);  // no jitter: the aim is the ball's centre
+  EXPECT_NEAR(target.range_m, 0.8, 1e-6);
+  EXPECT_NEAR(target.bearing_rad, 0.0, 1e-6);
+  EXPECT_EQ(target.kind, "buckyball");
+  // Aimed at a large ball where only a buckyball lies: the intake takes the buckyball.
+  const AttemptCheck other = pick(true, "large_ball");
+  EXPECT_EQ(other.outcome, "other");
+  EXPECT_EQ(other.target_truth_id, -1);
+  const AttemptCheck nothing = pick(false, "buckyball");
+  EXPECT_EQ(nothing.outcome, "nothing");
+  EXPECT_FALSE(nothing.ok);
 }
 
 // The robot and its strategy are told the season as its file has it; only the simulator
