@@ -33,6 +33,7 @@ struct DryRunArgs {
   std::string frames = "covariance";
   std::string out = "dry-run";
   double jitter_m = 0.15;
+  std::string scenario = "nominal";
   double speed_mps = 0.0;
   bool video = true;
   bool quiet = false;
@@ -83,6 +84,7 @@ int DryRun(const DryRunArgs& args) {
   try {
     mapping::ParseFrameRule(args.frames, &setup.frames);
     strategy::MakeStrategy(args.strategy, setup.strategy_options);
+    setup.scenario = ParseScenario(args.scenario);
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
@@ -90,7 +92,7 @@ int DryRun(const DryRunArgs& args) {
   if (!CreateOutputDir(args.out)) return 1;
   std::cout << "dry run: " << season.name << " (" << season.season << "), seed " << args.seed
             << ", strategy " << args.strategy << ", " << season.rules.autonomous_s
-            << " s autonomous\n";
+            << " s autonomous, " << ScenarioName(setup.scenario) << " layout\n";
   const MatchResult result =
       RunMatch(season, robot, setup, args.seed, args.out, [&](const TimelineEntry& e) {
         if (!args.quiet)
@@ -138,6 +140,11 @@ void RegisterDryRunCommand(CLI::App& app, CommandAction* action) {
       ->capture_default_str();
   cmd->add_option("--jitter", args->jitter_m,
                   "fixed object positions moved up to this far per seed (m)")
+      ->capture_default_str();
+  cmd->add_option("--scenario", args->scenario,
+                  "nominal: objects jittered up to --jitter; disturbed: objects moved 0.3-0.8 m "
+                  "from their spots, as after contact with an opponent (the robot is told the "
+                  "season file either way)")
       ->capture_default_str();
   cmd->add_option("--speed", args->speed_mps, "driving speed (m/s); 0: the robot's match_speed_mps")
       ->capture_default_str()

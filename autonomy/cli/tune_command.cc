@@ -26,6 +26,7 @@ struct TuneArgs {
   int matches = 20;
   uint64_t seed_base = 1;
   std::vector<std::string> params;
+  std::vector<std::string> scenarios;  // --scenario: shorthand for --param scenario=...
   int jobs = 1;
   std::string shard;  // "K/N"
   std::string out = "tune";
@@ -55,6 +56,15 @@ int Tune(const TuneArgs& args) {
   int shard_k = 1, shard_n = 1;
   try {
     for (const std::string& p : args.params) grid.push_back(ParseParam(p));
+    if (!args.scenarios.empty()) {
+      std::string joined;
+      for (const std::string& s : args.scenarios) joined += (joined.empty() ? "" : ",") + s;
+      for (const auto& [name, values] : grid) {
+        if (name == "scenario")
+          throw std::invalid_argument("--scenario and --param scenario=...: give one of them");
+      }
+      grid.push_back(ParseParam("scenario=" + joined));
+    }
     if (!args.shard.empty()) {
       if (std::sscanf(args.shard.c_str(), "%d/%d", &shard_k, &shard_n) != 2 || shard_n < 1 ||
           shard_k < 1 || shard_k > shard_n) {
@@ -156,6 +166,10 @@ void RegisterTuneCommand(CLI::App& app, CommandAction* action) {
       ->check(CLI::Range(1, 1000000));
   tune->add_option("--seed-base", args->seed_base, "first seed")->capture_default_str();
   tune->add_option("--param", args->params, params_help);
+  tune->add_option("--scenario", args->scenarios,
+                   "nominal and/or disturbed (comma-separated or repeated): the object layouts "
+                   "to run, as --param scenario=...")
+      ->delimiter(',');
   tune->add_option("--jobs", args->jobs, "processes to run matches on")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));

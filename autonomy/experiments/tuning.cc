@@ -45,6 +45,9 @@ const std::map<std::string, std::string>& TunableParams() {
       {"frames", "frame rule: fixed:N | covariance | gmm"},
       {"speed", "driving speed, m/s (0: the robot's match_speed_mps)"},
       {"jitter", "object placement jitter, m"},
+      {"scenario",
+       "nominal: objects jittered up to `jitter`; disturbed: objects moved 0.3-0.8 m (the robot is "
+       "told the season file either way)"},
       {"horizon", "planner: pick-and-score cycles searched ahead"},
       {"min_gain", "planner: expected points below which a cycle is not worth it"},
       {"look_frames", "frames of an exploratory look"},
@@ -73,6 +76,12 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->drive_speed_mps = ToDouble(name, value);
   } else if (name == "jitter") {
     setup->placement_jitter_m = ToDouble(name, value);
+  } else if (name == "scenario") {
+    try {
+      setup->scenario = ParseScenario(value);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--param scenario: ") + e.what());
+    }
   } else if (name == "horizon") {
     setup->strategy_options.horizon = ToInt(name, value);
   } else if (name == "min_gain") {

@@ -37,13 +37,13 @@ double CalibrateOdometryScale(const field::RobotConfig& robot) {
 
 class SimIo : public RobotIo {
  public:
-  SimIo(field::Alliance alliance, uint64_t seed, double jitter_m)
-      : alliance_(alliance), seed_(seed), jitter_m_(jitter_m), gyro_(seed) {}
+  SimIo(field::Alliance alliance, uint64_t seed, double jitter_m, Scenario scenario)
+      : alliance_(alliance), seed_(seed), jitter_m_(jitter_m), scenario_(scenario), gyro_(seed) {}
 
   void Start(const field::SeasonConfig& season, const field::RobotConfig& robot,
              const Pose2D& start) override {
     // The simulator and its renderer keep references to the field: it lives here.
-    field_ = PlaceObjects(season, jitter_m_, seed_);
+    field_ = PlaceObjects(season, jitter_m_, seed_, scenario_);
     const field::SeasonConfig& field = field_;
     robot_ = robot;
     platform::SimFieldOptions options;
@@ -110,6 +110,7 @@ class SimIo : public RobotIo {
   field::Alliance alliance_;
   uint64_t seed_;
   double jitter_m_;
+  Scenario scenario_;
   field::SeasonConfig field_;  // as placed
   field::RobotConfig robot_;
   platform::SimClock clock_;
@@ -121,16 +122,25 @@ class SimIo : public RobotIo {
 }  // namespace
 
 std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed,
-                                   double placement_jitter_m) {
-  return std::make_unique<SimIo>(alliance, seed, placement_jitter_m);
+                                   double placement_jitter_m, Scenario scenario) {
+  return std::make_unique<SimIo>(alliance, seed, placement_jitter_m, scenario);
 }
 
-field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m,
-                                 uint64_t seed) {
+field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m, uint64_t seed,
+                                 Scenario scenario) {
   field::SeasonConfig out = season;
-  if (jitter_m <= 0.0) return out;
-  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + 17);
+  const bool disturbed = scenario == Scenario::kDisturbed;
+  if (!disturbed && jitter_m <= 0.0) return out;
+  // Its own stream for the disturbed layout, so that a seed's nominal layout stays as it was.
+  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + (disturbed ? 29 : 17));
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> distance(kDisturbMin_m, kDisturbMax_m);
+  std::uniform_real_distribution<double> direction(-platform::kPi, platform::kPi);
+  const auto move = [&](const Eigen::Vector2d& nominal) -> Eigen::Vector2d {
+    if (!disturbed) return nominal + jitter_m * Eigen::Vector2d(unit(rng), unit(rng));
+    const double d = distance(rng), a = direction(rng);
+    return nominal + d * Eigen::Vector2d(std::cos(a), std::sin(a));
+  };
   std::optional<field::Vec2> stack_bottom;  // where the bottom of the current stack went
   for (field::ObjectPlacement& p : out.objects) {
     // A stack moves as one: its upper objects follow its bottom one.
@@ -149,7 +159,7 @@ field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitte
     const field::ObjectType* type = season.FindObjectType(p.type);
     const double r = type ? type->size_m / 2.0 : 0.1;
     for (int attempt = 0; attempt < 30; ++attempt) {
-      const Eigen::Vector2d c = nominal + jitter_m * Eigen::Vector2d(unit(rng), unit(rng));
+      const Eigen::Vector2d c = move(nominal);
       const double limit = season.HalfSize() - r;
       if (std::abs(c.x()) > limit || std::abs(c.y()) > limit) continue;
       if (platform::PointBlocksObject(season, c, r, type ? type->height_m : 0.0)) continue;
@@ -172,8 +182,8 @@ MatchResult RunMatchWith(std::unique_ptr<strategy::Strategy> strategy,
                          const field::SeasonConfig& season, const field::RobotConfig& robot,
                          const MatchSetup& setup, uint64_t seed, const std::string& out_dir,
                          const std::function<void(const TimelineEntry&)>& progress) {
-  return RunMatchOn(MakeSimIo(setup.alliance, seed, setup.placement_jitter_m), std::move(strategy),
-                    season, robot, setup, seed, out_dir, progress);
+  return RunMatchOn(MakeSimIo(setup.alliance, seed, setup.placement_jitter_m, setup.scenario),
+                    std::move(strategy), season, robot, setup, seed, out_dir, progress);
 }
 
 }  // namespace slamo::autonomy

@@ -23,12 +23,15 @@ namespace slamo::autonomy {
 // places its objects from it for `seed` (PlaceObjects with placement_jitter_m), and only the
 // simulator knows where they went.
 std::unique_ptr<RobotIo> MakeSimIo(field::Alliance alliance, uint64_t seed,
-                                   double placement_jitter_m = 0.0);
+                                   double placement_jitter_m = 0.0,
+                                   Scenario scenario = Scenario::kNominal);
 
-// The season with its fixed-position floor objects moved uniformly up to jitter_m (clear of
-// walls and structures), so no two seeds share a layout; preloads (objects on a starting
-// tile) stay.
-field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m, uint64_t seed);
+// The season with its fixed-position floor objects moved (clear of walls and structures), so
+// no two seeds share a layout: nominal, uniformly up to jitter_m along each axis; disturbed,
+// kDisturbMin_m to kDisturbMax_m in a uniform direction (jitter_m is not used). Preloads
+// (objects on a starting tile) and raised objects stay; a stack moves as one.
+field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitter_m, uint64_t seed,
+                                 Scenario scenario = Scenario::kNominal);
 
 // A dry run: one autonomous period on the simulated field (MakeSimIo), its objects placed for
 // `seed` (PlaceObjects with setup.placement_jitter_m); the robot and its strategy know only

@@ -175,6 +175,7 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
   result.seed = seed;
   result.strategy = strategy->name();
   result.frames = mapping::Describe(match_setup.frames);
+  result.scenario = ScenarioName(match_setup.scenario);
   result.deadline_s = world.deadline_s();
   result.robot_io = world.io().Describe();
   result.truth_known = world.io().TrueObjects().has_value();

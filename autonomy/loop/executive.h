@@ -81,6 +81,7 @@ struct MatchResult {
   uint64_t seed = 0;
   std::string strategy;
   std::string frames;    // the frame rule, described
+  std::string scenario;  // the object layout: nominal or disturbed (ScenarioName)
   int points = 0;        // the alliance's score at the deadline
   int points_start = 0;  // ... and at the start (objects already in scoring zones)
   double deadline_s = 0.0;

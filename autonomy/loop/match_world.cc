@@ -188,6 +188,16 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
   MaybeSnapshot(true);
 }
 
+const char* ScenarioName(Scenario scenario) {
+  return scenario == Scenario::kDisturbed ? "disturbed" : "nominal";
+}
+
+Scenario ParseScenario(const std::string& name) {
+  if (name == "nominal") return Scenario::kNominal;
+  if (name == "disturbed") return Scenario::kDisturbed;
+  throw std::invalid_argument("unknown scenario \"" + name + "\": expected nominal or disturbed");
+}
+
 strategy::Belief MatchWorld::Belief() const {
   strategy::Belief b;
   b.now_s = now_s();

@@ -30,6 +30,17 @@
 
 namespace slamo::autonomy {
 
+// Where the simulator puts the objects of a match. Nominal: each fixed-position floor object
+// moved up to MatchSetup::placement_jitter_m (today's layouts). Disturbed: each moved 0.3-0.8 m
+// from its spot in a random direction, as after contact with an opponent (preloads, raised
+// objects and stacks' upper objects stay with what they rest on). The robot is told the season
+// file either way.
+enum class Scenario { kNominal, kDisturbed };
+const char* ScenarioName(Scenario scenario);
+// "nominal" or "disturbed"; throws std::invalid_argument naming the choices.
+Scenario ParseScenario(const std::string& name);
+inline constexpr double kDisturbMin_m = 0.3, kDisturbMax_m = 0.8;
+
 struct MatchSetup {
   std::string strategy = "planner";  // strategy::StrategyNames()
   strategy::StrategyOptions strategy_options;
@@ -37,6 +48,7 @@ struct MatchSetup {
   field::Alliance alliance = field::Alliance::kRed;
   int start_index = 0;               // among the alliance's starting tiles
   double placement_jitter_m = 0.15;  // fixed-position objects moved up to this per seed
+  Scenario scenario = Scenario::kNominal;
   std::string planner = "rrtconnect";
   double plan_budget_s = 0.05;
   // Planner iterations per attempt instead of a time budget, so that a match depends only on

@@ -132,6 +132,7 @@ nlohmann::json ReportJson(const MatchResult& r) {
   j["seed"] = r.seed;
   j["strategy"] = r.strategy;
   j["frames"] = r.frames;
+  j["scenario"] = r.scenario;
   j["robot_io"] = r.robot_io;
   j["truth_known"] = r.truth_known;
   if (r.truth_known) {

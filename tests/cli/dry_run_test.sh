@@ -20,6 +20,8 @@ set +e
 "$slamo" dry-run --strategy random --out "$dir/bad" > /dev/null 2>&1; test $? -eq 2 || { echo "bad strategy: not 2"; exit 1; }
 "$slamo" dry-run --frames fixed:x --out "$dir/bad" > /dev/null 2>&1; test $? -eq 2 || { echo "bad frames: not 2"; exit 1; }
 "$slamo" tune --matches 1 --param warp=1 --out "$dir/bad" > /dev/null 2>&1; test $? -eq 2 || { echo "bad param: not 2"; exit 1; }
+"$slamo" tune --matches 1 --scenario wobbly --out "$dir/bad" > /dev/null 2>&1; test $? -eq 2 || { echo "bad scenario: not 2"; exit 1; }
+"$slamo" dry-run --scenario wobbly --out "$dir/bad" > /dev/null 2>&1; test $? -eq 2 || { echo "dry-run bad scenario: not 2"; exit 1; }
 set -e
 
 # SLAM-O on a recording: the report files; a folder that is no recording exits 2.
@@ -39,13 +41,22 @@ grep -q "error: " "$dir/fromrec_bad.txt"
 "$slamo" tune --matches 2 --param strategy=scripted,greedy --jobs 2 --out "$dir/tune" > "$dir/tune.txt" 2>/dev/null
 test -s "$dir/tune/tune.csv" && test -s "$dir/tune/tune.json"
 test "$(grep -c scripted "$dir/tune/tune.csv")" -eq 1
+# Every pick and release of those matches, judged, in attempts.csv.
+head -1 "$dir/tune/attempts.csv" | grep -q "^combo,seed,t_s,action,kind,colour,goal_index,range_m,bearing_deg,sigma_m,error_m,target_error_m,outcome$"
+test "$(grep -c ',SCORE,' "$dir/tune/attempts.csv")" -ge 1
+# Both layouts in one table.
+"$slamo" tune --matches 1 --param strategy=scripted --scenario nominal,disturbed --out "$dir/scen" > /dev/null 2>&1
+grep -q '"strategy=scripted scenario=nominal"' "$dir/scen/tune.csv"
+grep -q '"strategy=scripted scenario=disturbed"' "$dir/scen/tune.csv"
+"$slamo" dry-run --seed 2 --strategy scripted --scenario disturbed --no-video --quiet --out "$dir/dist" > /dev/null
+grep -q '"scenario": "disturbed"' "$dir/dist/report.json"
 "$slamo" tune --matches 2 --param strategy=scripted,greedy --shard 1/2 --out "$dir/shards" > /dev/null 2>&1
 "$slamo" tune --matches 2 --param strategy=scripted,greedy --shard 2/2 --out "$dir/shards" > /dev/null 2>&1
 "$slamo" tune merge "$dir/shards/shard-1-of-2.json" "$dir/shards/shard-2-of-2.json" --out "$dir/merged" > /dev/null
 cmp "$dir/tune/tune.csv" "$dir/merged/tune.csv" || {
   # Wall times differ between runs; compare everything but the last column.
-  cut -d, -f1-11 "$dir/tune/tune.csv" > "$dir/a.csv"
-  cut -d, -f1-11 "$dir/merged/tune.csv" > "$dir/b.csv"
+  cut -d, -f1-19 "$dir/tune/tune.csv" > "$dir/a.csv"
+  cut -d, -f1-19 "$dir/merged/tune.csv" > "$dir/b.csv"
   cmp "$dir/a.csv" "$dir/b.csv"
 }
 echo "dry-run and tune CLI checks passed"

@@ -221,6 +221,63 @@ TEST(Executive, TheRobotIsToldTheSeasonFileNotThePlacement) {
   EXPECT_GT(moved, 0.05);
 }
 
+// The disturbed layout: every fixed-position floor object 0.3-0.8 m from its spot, clear of
+// the walls and of what blocks it; preloads and raised objects where the file puts them.
+TEST(Executive, TheDisturbedLayoutMovesEveryFloorObjectThirtyToEightyCentimetres) {
+  for (const std::string name : {"toss_up", "high_stakes", "over_under", "push_back"}) {
+    const field::SeasonConfig season = field::LoadSeasonConfig(name);
+    for (uint64_t seed : {1, 2, 3}) {
+      const field::SeasonConfig placed = PlaceObjects(season, 0.15, seed, Scenario::kDisturbed);
+      ASSERT_EQ(placed.objects.size(), season.objects.size());
+      int moved = 0, floor = 0;
+      for (size_t i = 0; i < season.objects.size(); ++i) {
+        const field::ObjectPlacement& p = season.objects[i];
+        if (!p.position_m) continue;
+        const Eigen::Vector2d from(p.position_m->x, p.position_m->y);
+        const Eigen::Vector2d to(placed.objects[i].position_m->x, placed.objects[i].position_m->y);
+        const double d = (to - from).norm();
+        const bool preload =
+            std::any_of(season.starts.begin(), season.starts.end(), [&](const field::StartTile& s) {
+              return (from - Eigen::Vector2d(s.center_m.x, s.center_m.y)).norm() < 0.3;
+            });
+        if (p.z_m > 0.0 || preload) {
+          if (p.stack_level == 0) {
+            EXPECT_EQ(d, 0.0) << name << " object " << i;
+          }
+          continue;
+        }
+        if (p.stack_level > 0) continue;  // follows its stack's bottom object
+        ++floor;
+        if (d == 0.0) continue;  // no clear spot found: left where it was (counted below)
+        ++moved;
+        EXPECT_GE(d, kDisturbMin_m - 1e-9) << name << " object " << i;
+        EXPECT_LE(d, kDisturbMax_m + 1e-9) << name << " object " << i;
+        const field::ObjectType* type = season.FindObjectType(p.type);
+        ASSERT_NE(type, nullptr);
+        EXPECT_LE(std::max(std::abs(to.x()), std::abs(to.y())),
+                  season.HalfSize() - type->size_m / 2.0 + 1e-9)
+            << name << " object " << i;
+        EXPECT_FALSE(platform::PointBlocksObject(season, to, type->size_m / 2.0, type->height_m))
+            << name << " object " << i;
+      }
+      EXPECT_GT(floor, 0) << name;
+      EXPECT_GE(moved, floor * 9 / 10) << name << " seed " << seed;
+    }
+  }
+  // The nominal layout stays within its jitter along each axis.
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  const field::SeasonConfig nominal = PlaceObjects(season, 0.15, 4, Scenario::kNominal);
+  double largest = 0.0;
+  for (size_t i = 0; i < season.objects.size(); ++i) {
+    if (!season.objects[i].position_m) continue;
+    largest = std::max(
+        {largest, std::abs(nominal.objects[i].position_m->x - season.objects[i].position_m->x),
+         std::abs(nominal.objects[i].position_m->y - season.objects[i].position_m->y)});
+  }
+  EXPECT_LE(largest, 0.15 + 1e-9);
+  EXPECT_GT(largest, 0.05);
+}
+
 // A strategy that always asks to drive far away, claiming the drive takes `claimed_s`.
 class FarAway : public strategy::Strategy {
  public:
