@@ -18,6 +18,8 @@ namespace {
 using platform::kPi;
 // A staging pose within this distance counts as reached.
 constexpr double kAtStage_m = 0.25;
+// Position errors of the target and its neighbours the pick corridor allows for.
+constexpr double kCorridorSlack_m = 0.05;
 
 double Wrap(double a) {
   const double w = std::remainder(a, 2.0 * kPi);
@@ -270,10 +272,16 @@ class Base : public Strategy {
     if (const field::Structure* raised = RaisedOn(*c.season, o.kind, o.position_m))
       return KnockCycles(b, c, o, *raised, from, frames);
     const double r = ObjectRadius(*c.season, o.kind);
+    // The intake takes the object whose near edge is nearest the bumper across the robot's
+    // width: approach from a side where nothing else lies between the stage and the target,
+    // nor beside the target with its near edge as near (kCorridorSlack_m for the errors of
+    // both positions).
+    const double corridor =
+        options_.approach_margin_m + c.robot->intake.reach_m / 2.0 + kCorridorSlack_m;
     const std::optional<Eigen::Vector3d> stage =
-        PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m);
+        PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m,
+                  [&](const Eigen::Vector3d& s) { return CorridorFree(b, c, s, corridor, o.id); });
     if (!stage || failed_targets_.count(Key(*stage))) return out;
-    if (!CorridorFree(b, c, *stage, options_.approach_margin_m, o.id)) return out;
     const std::optional<double> t = c.travel_time_s(from, *stage);
     if (!t) return out;
     const double pick_s = *t + ApproachSeconds(c) + options_.pick_s;
@@ -326,8 +334,15 @@ class Base : public Strategy {
       return a;
     }
     const Eigen::Vector3d stage = cycle.object ? cycle.pick_stage : cycle.score_stage;
-    // Near enough: the pick and the release turn to their target and drive the rest.
-    const bool at_stage = (b.pose.head<2>() - stage.head<2>()).norm() < kAtStage_m;
+    // Near enough: the pick and the release turn to their target and drive the rest. A pick
+    // also needs the object no nearer than where the intake takes it: closer, the turn to it
+    // would sweep it with the robot's corners (after a drop, the robot stands beside it).
+    bool at_stage = (b.pose.head<2>() - stage.head<2>()).norm() < kAtStage_m;
+    if (cycle.object && !cycle.knock) {
+      const double r = ObjectRadius(*c.season, cycle.object->kind);
+      at_stage = at_stage && (cycle.object->position_m - b.pose.head<2>()).norm() >=
+                                 PickDistance(*c.robot, r) - kAtStage_m / 10.0;
+    }
     if (cycle.knock) {
       a.kind = ActionKind::kNavigate;
       a.object_id = cycle.object->id;
@@ -845,9 +860,10 @@ double ReleaseDistance(const field::RobotConfig& robot, double object_radius_m) 
   return robot.length_m / 2.0 + object_radius_m + 0.01;
 }
 
-std::optional<Eigen::Vector3d> PickStage(const StrategyContext& context,
-                                         const Eigen::Vector2d& object, double object_radius_m,
-                                         const Eigen::Vector2d& from, double margin_m) {
+std::optional<Eigen::Vector3d> PickStage(
+    const StrategyContext& context, const Eigen::Vector2d& object, double object_radius_m,
+    const Eigen::Vector2d& from, double margin_m,
+    const std::function<bool(const Eigen::Vector3d&)>& accept) {
   const double d = PickDistance(*context.robot, object_radius_m) + margin_m;
   Eigen::Vector2d u = object - from;
   const double base = u.norm() > 1e-6 ? std::atan2(u.y(), u.x()) : 0.0;
@@ -856,7 +872,8 @@ std::optional<Eigen::Vector3d> PickStage(const StrategyContext& context,
     const double heading = base + offset_deg * kPi / 180.0;
     const Eigen::Vector2d stage =
         object - d * Eigen::Vector2d(std::cos(heading), std::sin(heading));
-    if (context.is_clear(stage)) return Eigen::Vector3d(stage.x(), stage.y(), Wrap(heading));
+    const Eigen::Vector3d pose(stage.x(), stage.y(), Wrap(heading));
+    if (context.is_clear(stage) && (!accept || accept(pose))) return pose;
   }
   return std::nullopt;
 }

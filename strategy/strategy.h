@@ -154,10 +154,13 @@ int FloorPoints(const field::SeasonConfig& season, const Eigen::Vector2d& positi
                 const std::string& kind, const std::string& colour, field::Alliance alliance);
 
 // Where the robot stands (x, y, heading) to pick an object: the staging pose `margin_m`
-// behind the final approach, facing the object, approached from `from` when that side is clear.
-std::optional<Eigen::Vector3d> PickStage(const StrategyContext& context,
-                                         const Eigen::Vector2d& object, double object_radius_m,
-                                         const Eigen::Vector2d& from, double margin_m);
+// behind the final approach, facing the object, approached from `from` when that side is clear
+// (and `accept`, when given, takes the stage: e.g. nothing else in the intake's corridor),
+// else from the nearest heading round the object that is.
+std::optional<Eigen::Vector3d> PickStage(
+    const StrategyContext& context, const Eigen::Vector2d& object, double object_radius_m,
+    const Eigen::Vector2d& from, double margin_m,
+    const std::function<bool(const Eigen::Vector3d&)>& accept = {});
 // Distance from the robot's centre to an object's centre at which the intake takes it.
 double PickDistance(const field::RobotConfig& robot, double object_radius_m);
 

@@ -455,14 +455,15 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
 std::string AttemptsCsv(const std::vector<MatchOutcome>& outcomes) {
   std::ostringstream out;
   out << "combo,seed,t_s,action,kind,colour,goal_index,range_m,bearing_deg,sigma_m,error_m,"
-         "target_error_m,outcome\n";
+         "target_error_m,outcome,taken_kind,taken_colour\n";
   out << std::setprecision(6);
   for (const MatchOutcome& o : outcomes) {
     for (const AttemptCheck& a : o.records) {
       out << '"' << o.combo << "\"," << o.seed << ',' << a.t_s << ',' << a.action << ',' << a.kind
           << ',' << a.colour << ',' << a.goal_index << ',' << a.range_m << ','
           << a.bearing_rad * 180.0 / M_PI << ',' << a.three_sigma_m / 3.0 << ',' << a.error_m << ','
-          << a.target_error_m << ',' << a.outcome << '\n';
+          << a.target_error_m << ',' << a.outcome << ',' << a.taken_kind << ',' << a.taken_colour
+          << '\n';
     }
   }
   return out.str();

@@ -83,6 +83,10 @@ void JudgeAttempt(const std::vector<TrueObject>& before, const std::vector<TrueO
     }
   }
   if (c->action == "PICK") {
+    for (const TrueObject& a : after) {
+      if (!taken.empty() && a.id == taken.front())
+        c->taken_kind = a.kind, c->taken_colour = a.colour;
+    }
     if (taken.empty())
       c->outcome = "nothing";
     else

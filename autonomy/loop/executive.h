@@ -68,6 +68,8 @@ struct AttemptCheck {
   // SCORE: "scored" (in the goal aimed at), "missed" (released elsewhere), "nothing" (nothing
   // left the intake).
   std::string outcome;
+  // PICK: the kind and colour of what the intake took (empty: nothing).
+  std::string taken_kind, taken_colour;
 };
 inline constexpr double kTargetMatch_m = 0.5;
 const std::vector<std::string>& PickOutcomes();   // target, other, nothing

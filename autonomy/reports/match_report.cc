@@ -102,7 +102,9 @@ nlohmann::json AttemptJson(const AttemptCheck& a) {
           {"bearing_rad", a.bearing_rad},
           {"target_truth_id", a.target_truth_id},
           {"target_error_m", a.target_error_m},
-          {"outcome", a.outcome}};
+          {"outcome", a.outcome},
+          {"taken_kind", a.taken_kind},
+          {"taken_colour", a.taken_colour}};
 }
 
 AttemptCheck AttemptFromJson(const nlohmann::json& j) {
@@ -123,6 +125,8 @@ AttemptCheck AttemptFromJson(const nlohmann::json& j) {
   a.target_truth_id = j.at("target_truth_id").get<int>();
   a.target_error_m = j.at("target_error_m").get<double>();
   a.outcome = j.at("outcome").get<std::string>();
+  a.taken_kind = j.value("taken_kind", "");
+  a.taken_colour = j.value("taken_colour", "");
   return a;
 }
 

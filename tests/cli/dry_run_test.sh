@@ -42,7 +42,7 @@ grep -q "error: " "$dir/fromrec_bad.txt"
 test -s "$dir/tune/tune.csv" && test -s "$dir/tune/tune.json"
 test "$(grep -c scripted "$dir/tune/tune.csv")" -eq 1
 # Every pick and release of those matches, judged, in attempts.csv.
-head -1 "$dir/tune/attempts.csv" | grep -q "^combo,seed,t_s,action,kind,colour,goal_index,range_m,bearing_deg,sigma_m,error_m,target_error_m,outcome$"
+head -1 "$dir/tune/attempts.csv" | grep -q "^combo,seed,t_s,action,kind,colour,goal_index,range_m,bearing_deg,sigma_m,error_m,target_error_m,outcome,taken_kind,taken_colour$"
 test "$(grep -c ',SCORE,' "$dir/tune/attempts.csv")" -ge 1
 # Both layouts in one table.
 "$slamo" tune --matches 1 --param strategy=scripted --scenario nominal,disturbed --out "$dir/scen" > /dev/null 2>&1

@@ -201,6 +201,47 @@ TEST_F(StrategyTest, ABallOnTheBarrierIsKnockedIntoTheGoalZoneNotPicked) {
   }
 }
 
+// The intake takes the object whose near edge is nearest the bumper across the robot's width:
+// a blue ball beside the red target, as near, would be taken instead. The approach comes from
+// a side where the target is alone in the corridor (straight on from the west it was not).
+TEST_F(StrategyTest, APickIsApproachedFromASideWhereTheTargetIsAloneInTheCorridor) {
+  const Eigen::Vector2d target(-0.45, 1.0), beside(-0.33, 1.0);
+  const auto first_navigation = [&](const std::string& name, bool with_neighbour) {
+    std::unique_ptr<Strategy> strategy = MakeStrategy(name, StrategyOptions{});
+    Belief b;
+    b.pose = Eigen::Vector3d(-0.45, 0.2, M_PI / 2.0);
+    b.objects.push_back(
+        ObjectBelief{7, "buckyball", "red", target, Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    if (with_neighbour) {
+      b.objects.push_back(
+          ObjectBelief{8, "buckyball", "blue", beside, Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    }
+    Action a = strategy->Next(b, context_);
+    for (int k = 0; k < 20 && a.kind == ActionKind::kObserve; ++k) a = strategy->Next(b, context_);
+    return a;
+  };
+  for (const std::string name : {"planner", "greedy"}) {
+    // Alone: straight on, from the side the robot comes from (the south).
+    const Action alone = first_navigation(name, false);
+    ASSERT_EQ(alone.kind, ActionKind::kNavigate) << name << ": " << alone.why;
+    ASSERT_EQ(alone.object_id, 7) << name << ": " << alone.why;
+    EXPECT_NEAR(std::remainder(alone.target.z(), 2 * M_PI), M_PI / 2.0, 1e-6) << name;
+    // With a blue ball beside it: from another side, where the blue ball lies outside the
+    // robot's width or clearly beyond the target's near edge.
+    const Action a = first_navigation(name, true);
+    ASSERT_EQ(a.kind, ActionKind::kNavigate) << name << ": " << a.why;
+    ASSERT_EQ(a.object_id, 7) << name << ": " << a.why;
+    const Eigen::Vector2d dir(std::cos(a.target.z()), std::sin(a.target.z()));
+    const Eigen::Vector2d rel = beside - a.target.head<2>();
+    const double along = rel.dot(dir) - (target - a.target.head<2>()).dot(dir);
+    const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
+    EXPECT_TRUE(side > robot_.width_m / 2.0 + 0.0635 || along > 0.05)
+        << name << ": stage heading " << a.target.z() * 180.0 / M_PI << " deg, blue ball " << side
+        << " m aside, " << along << " m beyond the target";
+    EXPECT_GT(std::abs(std::remainder(a.target.z(), 2 * M_PI) - M_PI / 2.0), 0.2) << name;
+  }
+}
+
 // The scripted route from the red hanging-zone tile, planned on the nominal layout: it
 // releases the preload, knocks a red large ball off the barrier, and its planned actions
 // fit in the period.
