@@ -98,16 +98,29 @@ class Base : public Strategy {
 
   // Heading error adds lateral error growing with the distance driven; approximated at the
   // approach distance.
-  double PickProbability(const Belief& b, const ObjectBelief& o, int frames) const {
+  // With a learned model: at the stage, facing the target, range_m from it.
+  double PickProbability(const Belief& b, const ObjectBelief& o, int frames, double range_m) const {
     const double pose_var = PoseVarianceAfter(b, frames);
+    if (options_.learned_success) {
+      if (const std::optional<double> p =
+              options_.learned_success("PICK", o.kind, range_m, 0.0, std::sqrt(pose_var)))
+        return *p * o.confidence;
+    }
     const double heading_var = b.pose_covariance(2, 2);
     Eigen::Matrix2d cov =
         o.covariance + Eigen::Matrix2d::Identity() * (pose_var + heading_var * 0.25);
     return SuccessProbability(cov, options_.pick_tolerance_m) * o.confidence;
   }
 
-  double ScoreProbability(const Belief& b, const StrategyContext& c, int goal, int frames) const {
+  double ScoreProbability(const Belief& b, const StrategyContext& c, int goal, int frames,
+                          const std::string& kind, const Eigen::Vector3d& stage) const {
     const field::Goal& g = c.season->goals[goal];
+    if (options_.learned_success) {
+      const double range = std::hypot(g.center_m.x - stage.x(), g.center_m.y - stage.y());
+      if (const std::optional<double> p = options_.learned_success(
+              "SCORE", kind, range, 0.0, std::sqrt(PoseVarianceAfter(b, frames))))
+        return *p;
+    }
     // A goal structure forgives its radius less the drop's offset; a zone forgives more.
     const double tolerance =
         g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * g.radius_m) : 0.3;
@@ -298,7 +311,8 @@ class Base : public Strategy {
       cycle.score_stage = g.stage;
       cycle.seconds = pick_s + g.seconds + frames / c.frame_rate_hz;
       cycle.gain = g.points - before;
-      cycle.probability = PickProbability(b, o, frames) * ScoreProbability(b, c, g.goal, frames);
+      cycle.probability = PickProbability(b, o, frames, (o.position_m - stage->head<2>()).norm()) *
+                          ScoreProbability(b, c, g.goal, frames, o.kind, g.stage);
       cycle.frames = frames;
       out.push_back(cycle);
     }
@@ -313,7 +327,7 @@ class Base : public Strategy {
       cycle.score_stage = g.stage;
       cycle.seconds = g.seconds + frames / c.frame_rate_hz;
       cycle.gain = g.points;  // a held object counts nothing until released
-      cycle.probability = ScoreProbability(b, c, g.goal, frames);
+      cycle.probability = ScoreProbability(b, c, g.goal, frames, b.held->kind, g.stage);
       cycle.frames = frames;
       out.push_back(cycle);
     }

@@ -105,6 +105,13 @@ struct StrategyOptions {
   // bias per stop (the iterated-frame model: sigma^2 = white^2 / n + bias^2).
   double frame_white_sigma_m = 0.03;
   double frame_bias_sigma_m = 0.01;
+  // P(success) of a pick (action "PICK", the target's kind) or a release ("SCORE", the held
+  // object's kind) learned from the simulator's outcomes (`slamo tune calibrate`), from the
+  // range and bearing of the target when the attempt starts and the pose sigma then; unset,
+  // or nothing for that kind: the tolerance model (SuccessProbability).
+  std::function<std::optional<double>(const std::string& action, const std::string& kind,
+                                      double range_m, double bearing_rad, double sigma_m)>
+      learned_success;
   double min_gain = 0.25;         // expected points below this are not worth a cycle
   int look_frames = 10;           // frames of an exploratory look
   int arrival_frames = 5;         // planner: frames to check an arrival

@@ -13,6 +13,7 @@
 
 #include "autonomy/cli/commands.h"
 #include "autonomy/cli/options.h"
+#include "autonomy/experiments/calibration.h"
 #include "autonomy/experiments/recording_run.h"
 #include "autonomy/io/sim_io.h"
 #include "autonomy/loop/executive.h"
@@ -34,6 +35,7 @@ struct DryRunArgs {
   std::string out = "dry-run";
   double jitter_m = 0.15;
   std::string scenario = "nominal";
+  std::string calibration;  // a `slamo tune calibrate` file: learned P(success)
   double speed_mps = 0.0;
   bool video = true;
   bool quiet = false;
@@ -85,6 +87,10 @@ int DryRun(const DryRunArgs& args) {
     mapping::ParseFrameRule(args.frames, &setup.frames);
     strategy::MakeStrategy(args.strategy, setup.strategy_options);
     setup.scenario = ParseScenario(args.scenario);
+    if (!args.calibration.empty()) {
+      setup.strategy_options.learned_success =
+          LearnedSuccess(LoadCalibration(args.calibration, season.season, robot.name));
+    }
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
@@ -146,6 +152,9 @@ void RegisterDryRunCommand(CLI::App& app, CommandAction* action) {
                   "from their spots, as after contact with an opponent (the robot is told the "
                   "season file either way)")
       ->capture_default_str();
+  cmd->add_option("--calibration", args->calibration,
+                  "pick and release success models from `slamo tune calibrate` for this season "
+                  "and robot (default: the tolerance model)");
   cmd->add_option("--speed", args->speed_mps, "driving speed (m/s); 0: the robot's match_speed_mps")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 5.0));

@@ -3,6 +3,7 @@
 // runs every N-th match only (for a batch system) and writes its outcomes; `tune merge`
 // ranks the shards' outcomes together. Exit status: 0, 1 when files cannot be written, 2 on
 // bad input.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +15,7 @@
 
 #include "autonomy/cli/commands.h"
 #include "autonomy/cli/options.h"
+#include "autonomy/experiments/calibration.h"
 #include "autonomy/experiments/tuning.h"
 #include "field_configs/loader.h"
 
@@ -27,11 +29,36 @@ struct TuneArgs {
   uint64_t seed_base = 1;
   std::vector<std::string> params;
   std::vector<std::string> scenarios;  // --scenario: shorthand for --param scenario=...
+  std::string calibration;             // learned P(success) for every match
   int jobs = 1;
   std::string shard;  // "K/N"
   std::string out = "tune";
   std::vector<std::string> merge_files;
+  std::vector<std::string> calibrate_files;
+  std::string combo;            // calibrate: only this combination's matches
+  std::string calibration_out;  // calibrate: the model file
 };
+
+// tune.json files (or shards) -> their match outcomes; false (and a message) when one cannot
+// be read.
+bool ReadOutcomes(const std::vector<std::string>& files, std::vector<MatchOutcome>* outcomes) {
+  for (const std::string& file : files) {
+    std::ifstream in(file);
+    if (!in) {
+      std::cerr << "error: " << file << ": cannot read\n";
+      return false;
+    }
+    try {
+      const nlohmann::json j = nlohmann::json::parse(in);
+      const nlohmann::json& list = j.is_array() ? j : j.at("matches");
+      for (const nlohmann::json& o : list) outcomes->push_back(OutcomeFromJson(o));
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << file << ": not a tune shard or tune.json (" << e.what() << ")\n";
+      return false;
+    }
+  }
+  return true;
+}
 
 bool WriteText(const std::string& path, const std::string& text) {
   std::ofstream out(path);
@@ -78,6 +105,16 @@ int Tune(const TuneArgs& args) {
   }
   const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
   const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  MatchSetup base;
+  if (!args.calibration.empty()) {
+    try {
+      base.strategy_options.learned_success =
+          LearnedSuccess(LoadCalibration(args.calibration, season.season, robot.name));
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 2;
+    }
+  }
   const std::vector<ParamSet> combos = Combinations(grid);
   std::vector<TuneTask> tasks;
   size_t index = 0;
@@ -99,8 +136,9 @@ int Tune(const TuneArgs& args) {
   std::cout << ": " << tasks.size() << " matches on " << args.jobs << " process(es)\n";
 
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<MatchOutcome> outcomes =
-      RunTasks(season, robot, combos, tasks, args.jobs, [&](size_t done, size_t total) {
+  const std::vector<MatchOutcome> outcomes = RunTasks(
+      season, robot, combos, tasks, args.jobs,
+      [&](size_t done, size_t total) {
         const double elapsed =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const double eta = done ? elapsed / done * (total - done) : 0.0;
@@ -110,7 +148,8 @@ int Tune(const TuneArgs& args) {
                      done, total, done / std::max(elapsed, 1e-9) * 60.0, static_cast<int>(eta) / 60,
                      static_cast<int>(eta) % 60);
         if (done == total) std::fprintf(stderr, "\n");
-      });
+      },
+      base);
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "throughput: " << tasks.size() << " matches in " << elapsed << " s, "
@@ -131,25 +170,42 @@ int Tune(const TuneArgs& args) {
 
 int Merge(const TuneArgs& args) {
   std::vector<MatchOutcome> outcomes;
-  for (const std::string& file : args.merge_files) {
-    std::ifstream in(file);
-    if (!in) {
-      std::cerr << "error: " << file << ": cannot read\n";
-      return 2;
-    }
-    try {
-      const nlohmann::json j = nlohmann::json::parse(in);
-      const nlohmann::json& list = j.is_array() ? j : j.at("matches");
-      for (const nlohmann::json& o : list) outcomes.push_back(OutcomeFromJson(o));
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << file << ": not a tune shard or tune.json (" << e.what() << ")\n";
-      return 2;
-    }
-  }
+  if (!ReadOutcomes(args.merge_files, &outcomes)) return 2;
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   std::cout << outcomes.size() << " matches from " << args.merge_files.size() << " file(s)\n";
   return Report(outcomes, args.out);
+}
+
+// Success models from the attempts of the matches in the files: printed with their
+// reliability table, written as JSON.
+int CalibrateCommand(const TuneArgs& args) {
+  std::vector<MatchOutcome> outcomes;
+  if (!ReadOutcomes(args.calibrate_files, &outcomes)) return 2;
+  if (!args.combo.empty()) {
+    outcomes.erase(std::remove_if(outcomes.begin(), outcomes.end(),
+                                  [&](const MatchOutcome& o) { return o.combo != args.combo; }),
+                   outcomes.end());
+  }
+  const std::vector<AttemptSample> samples = SamplesOf(outcomes);
+  if (samples.empty()) {
+    std::cerr << "error: no judged pick or release attempts in " << outcomes.size()
+              << " matches (tune.json files from this version of slamo tune record them"
+              << (args.combo.empty() ? "" : "; --combo \"" + args.combo + "\" may match none")
+              << ")\n";
+    return 2;
+  }
+  const field::SeasonConfig season = field::LoadSeasonConfig(args.season);
+  const field::RobotConfig robot = field::LoadRobotConfig(args.robot);
+  const Calibration calibration = Calibrate(samples, season.season, robot.name);
+  std::cout << outcomes.size() << " matches, " << samples.size() << " attempts\n";
+  PrintCalibration(calibration, samples, std::cout);
+  const std::string path = args.calibration_out.empty()
+                               ? "calibration-" + robot.name + "-" + season.season + ".json"
+                               : args.calibration_out;
+  if (!WriteText(path, ToJson(calibration).dump(2) + "\n")) return 1;
+  std::cout << "wrote " << path << "\n";
+  return 0;
 }
 
 }  // namespace
@@ -170,6 +226,9 @@ void RegisterTuneCommand(CLI::App& app, CommandAction* action) {
                    "nominal and/or disturbed (comma-separated or repeated): the object layouts "
                    "to run, as --param scenario=...")
       ->delimiter(',');
+  tune->add_option("--calibration", args->calibration,
+                   "pick and release success models from `slamo tune calibrate` for this "
+                   "season and robot, for every match (default: the tolerance model)");
   tune->add_option("--jobs", args->jobs, "processes to run matches on")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));
@@ -185,8 +244,23 @@ void RegisterTuneCommand(CLI::App& app, CommandAction* action) {
       ->required();
   merge->add_option("--out", args->out, "directory for tune.csv and tune.json")
       ->capture_default_str();
-  tune->callback([args, action, merge]() {
-    if (merge->parsed()) {
+  CLI::App* calibrate = tune->add_subcommand(
+      "calibrate",
+      "fit pick and release success models to the attempts of tune runs, with a reliability "
+      "table; e.g. slamo tune calibrate tune/tune.json --combo \"strategy=planner\"");
+  calibrate->add_option("files", args->calibrate_files, "tune.json files or shards")->required();
+  calibrate->add_option("--combo", args->combo,
+                        "only the matches of this parameter combination (as tune.csv names it)");
+  calibrate->add_option("--season", args->season, "the season the matches ran on (for the file)")
+      ->capture_default_str();
+  calibrate->add_option("--robot", args->robot, "the robot the matches ran with (for the file)")
+      ->capture_default_str();
+  calibrate->add_option("--out", args->calibration_out,
+                        "the model file (default: calibration-ROBOT-SEASON.json)");
+  tune->callback([args, action, merge, calibrate]() {
+    if (calibrate->parsed()) {
+      *action = [args]() { return CalibrateCommand(*args); };
+    } else if (merge->parsed()) {
       *action = [args]() { return Merge(*args); };
     } else {
       *action = [args]() { return Tune(*args); };

@@ -217,7 +217,8 @@ std::vector<MatchOutcome> RunTasks(const field::SeasonConfig& season,
                                    const field::RobotConfig& robot,
                                    const std::vector<ParamSet>& combos,
                                    const std::vector<TuneTask>& tasks, int jobs,
-                                   const std::function<void(size_t, size_t)>& progress) {
+                                   const std::function<void(size_t, size_t)>& progress,
+                                   const MatchSetup& base) {
   std::vector<MatchOutcome> out(tasks.size());
   struct Child {
     pid_t pid;
@@ -238,7 +239,7 @@ std::vector<MatchOutcome> RunTasks(const field::SeasonConfig& season,
       o.combo = Describe(combos[tasks[t].combo_index]);
       o.seed = tasks[t].seed;
       try {
-        MatchSetup setup;
+        MatchSetup setup = base;
         setup.snapshot_period_s = 0.0;
         for (const auto& [name, value] : combos[tasks[t].combo_index])
           ApplyParam(name, value, &setup);

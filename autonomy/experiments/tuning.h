@@ -59,12 +59,14 @@ struct TuneTask {
   uint64_t seed = 0;
 };
 
-// Runs the tasks on `jobs` processes; `progress(done, total)` after each.
+// Runs the tasks on `jobs` processes; `progress(done, total)` after each. Every match starts
+// from `base` (snapshots off) with its combination's parameters applied.
 std::vector<MatchOutcome> RunTasks(const field::SeasonConfig& season,
                                    const field::RobotConfig& robot,
                                    const std::vector<ParamSet>& combos,
                                    const std::vector<TuneTask>& tasks, int jobs,
-                                   const std::function<void(size_t, size_t)>& progress);
+                                   const std::function<void(size_t, size_t)>& progress,
+                                   const MatchSetup& base = MatchSetup());
 
 struct ComboSummary {
   std::string combo;

@@ -44,6 +44,15 @@ test "$(grep -c scripted "$dir/tune/tune.csv")" -eq 1
 # Every pick and release of those matches, judged, in attempts.csv.
 head -1 "$dir/tune/attempts.csv" | grep -q "^combo,seed,t_s,action,kind,colour,goal_index,range_m,bearing_deg,sigma_m,error_m,target_error_m,outcome,taken_kind,taken_colour$"
 test "$(grep -c ',SCORE,' "$dir/tune/attempts.csv")" -ge 1
+# Success models from those attempts, read back by a dry run; refused for another season.
+"$slamo" tune calibrate "$dir/tune/tune.json" --out "$dir/cal.json" > "$dir/cal.txt"
+grep -q "reliability, PICK" "$dir/cal.txt"
+grep -q '"robot": "thesis_robot"' "$dir/cal.json"
+"$slamo" dry-run --seed 1 --calibration "$dir/cal.json" --no-video --quiet --out "$dir/calrun" > /dev/null
+set +e
+"$slamo" dry-run --season high_stakes --calibration "$dir/cal.json" --out "$dir/bad" > /dev/null 2>&1; test $? -eq 2 || { echo "calibration of another season: not 2"; exit 1; }
+"$slamo" tune calibrate "$dir/no_such.json" > /dev/null 2>&1; test $? -eq 2 || { echo "calibrate a missing file: not 2"; exit 1; }
+set -e
 # Both layouts in one table.
 "$slamo" tune --matches 1 --param strategy=scripted --scenario nominal,disturbed --out "$dir/scen" > /dev/null 2>&1
 grep -q '"strategy=scripted scenario=nominal"' "$dir/scen/tune.csv"

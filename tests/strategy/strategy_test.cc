@@ -242,6 +242,44 @@ TEST_F(StrategyTest, APickIsApproachedFromASideWhereTheTargetIsAloneInTheCorrido
   }
 }
 
+// A learned P(success) (`slamo tune calibrate`) replaces the tolerance model: told that picks
+// never work, the planner does not go for the ball it would otherwise pick.
+TEST_F(StrategyTest, TheLearnedSuccessModelDecidesWhetherAPickIsWorthIt) {
+  const auto first = [&](const StrategyOptions& options) {
+    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
+    Belief b;
+    b.pose = Eigen::Vector3d(-0.45, 0.2, M_PI / 2.0);
+    b.objects.push_back(ObjectBelief{7, "buckyball", "red", Eigen::Vector2d(-0.45, 1.0),
+                                     Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    Action a = planner->Next(b, context_);
+    for (int k = 0; k < 20 && a.kind == ActionKind::kObserve; ++k) a = planner->Next(b, context_);
+    return a;
+  };
+  StrategyOptions options;
+  int asked = 0;
+  options.learned_success = [&](const std::string& action, const std::string& kind, double range,
+                                double, double sigma) -> std::optional<double> {
+    ++asked;
+    EXPECT_TRUE(action == "PICK" || action == "SCORE");
+    EXPECT_GT(range, 0.0);
+    EXPECT_GE(sigma, 0.0);
+    if (action == "PICK") {
+      EXPECT_EQ(kind, "buckyball");
+    }
+    return action == "PICK" ? 1.0 : 0.9;
+  };
+  const Action sure = first(options);
+  EXPECT_GT(asked, 0);
+  EXPECT_EQ(sure.kind, ActionKind::kNavigate) << sure.why;
+  EXPECT_EQ(sure.object_id, 7) << sure.why;
+  options.learned_success = [](const std::string& action, const std::string&, double, double,
+                               double) -> std::optional<double> {
+    return action == "PICK" ? 0.0 : 0.9;
+  };
+  const Action never = first(options);
+  EXPECT_FALSE(never.kind == ActionKind::kNavigate && never.object_id == 7) << never.why;
+}
+
 // The scripted route from the red hanging-zone tile, planned on the nominal layout: it
 // releases the preload, knocks a red large ball off the barrier, and its planned actions
 // fit in the period.
