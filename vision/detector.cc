@@ -55,6 +55,8 @@ struct ArcFit {
   double coverage_deg = 0.0;  // 360 minus the largest angular gap between points
 };
 
+// The circle alone (centre and radius; rms and coverage are left 0): FitArc refits up to
+// four times and needs the statistics of the last fit only.
 std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   if (points.size() < 8) return std::nullopt;
   cv::Point2d mean(0, 0);
@@ -64,9 +66,10 @@ std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   cv::Mat a(n, 3, CV_64F), b(n, 1, CV_64F);
   for (int i = 0; i < n; ++i) {
     const double x = points[i].x - mean.x, y = points[i].y - mean.y;
-    a.at<double>(i, 0) = x;
-    a.at<double>(i, 1) = y;
-    a.at<double>(i, 2) = 1.0;
+    double* row = a.ptr<double>(i);
+    row[0] = x;
+    row[1] = y;
+    row[2] = 1.0;
     b.at<double>(i, 0) = -(x * x + y * y);
   }
   cv::Mat solution;
@@ -77,21 +80,58 @@ std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   ArcFit fit;
   fit.centre = mean + cv::Point2d(cx, cy);
   fit.radius = std::sqrt(r2);
-  std::vector<double> angles;
-  angles.reserve(points.size());
-  double sum2 = 0.0;
-  for (const cv::Point& p : points) {
-    const cv::Point2d d = cv::Point2d(p) - fit.centre;
-    const double e = std::hypot(d.x, d.y) - fit.radius;
-    sum2 += e * e;
-    angles.push_back(std::atan2(d.y, d.x));
-  }
-  fit.rms = std::sqrt(sum2 / points.size());
-  std::sort(angles.begin(), angles.end());
-  double gap = 2.0 * M_PI - (angles.back() - angles.front());
-  for (size_t i = 1; i < angles.size(); ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
-  fit.coverage_deg = 360.0 - gap * 180.0 / M_PI;
   return fit;
+}
+
+// The largest difference between consecutive values of `values` once sorted, without
+// sorting (the maximum-gap bucket method): the largest gap is at least (max - min) / (n - 1),
+// wider than a bucket of (max - min) / n, so it always lies between the highest value of one
+// non-empty bucket and the lowest of the next. The bucket index is monotonic in the value,
+// so those are consecutive values of the sorted order, and their difference is the same
+// double the sorted scan computes.
+double LargestSortedGap(const std::vector<double>& values) {
+  const size_t n = values.size();
+  if (n < 2) return 0.0;
+  const auto [lo_it, hi_it] = std::minmax_element(values.begin(), values.end());
+  const double lo = *lo_it, range = *hi_it - lo;
+  if (!(range > 0.0)) return 0.0;
+  thread_local std::vector<double> bucket_lo, bucket_hi;
+  bucket_lo.assign(n, std::numeric_limits<double>::infinity());
+  bucket_hi.assign(n, -std::numeric_limits<double>::infinity());
+  const double scale = static_cast<double>(n) / range;
+  for (const double v : values) {
+    const size_t k = std::min(n - 1, static_cast<size_t>((v - lo) * scale));
+    bucket_lo[k] = std::min(bucket_lo[k], v);
+    bucket_hi[k] = std::max(bucket_hi[k], v);
+  }
+  double gap = 0.0, previous_hi = bucket_hi[0];  // bucket 0 holds the minimum
+  for (size_t k = 1; k < n; ++k) {
+    if (bucket_lo[k] > bucket_hi[k]) continue;  // empty
+    gap = std::max(gap, bucket_lo[k] - previous_hi);
+    previous_hi = bucket_hi[k];
+  }
+  return gap;
+}
+
+// rms distance of the points to the fitted circle and its angular coverage.
+void MeasureArc(const std::vector<cv::Point>& points, ArcFit* fit) {
+  thread_local std::vector<double> angles;
+  angles.clear();
+  double sum2 = 0.0;
+  double lowest = std::numeric_limits<double>::infinity();
+  double highest = -std::numeric_limits<double>::infinity();
+  for (const cv::Point& p : points) {
+    const cv::Point2d d = cv::Point2d(p) - fit->centre;
+    const double e = std::hypot(d.x, d.y) - fit->radius;
+    sum2 += e * e;
+    const double angle = std::atan2(d.y, d.x);
+    angles.push_back(angle);
+    lowest = std::min(lowest, angle);
+    highest = std::max(highest, angle);
+  }
+  fit->rms = std::sqrt(sum2 / points.size());
+  const double gap = std::max(2.0 * M_PI - (highest - lowest), LargestSortedGap(angles));
+  fit->coverage_deg = 360.0 - gap * 180.0 / M_PI;
 }
 
 // A circle through an outline whose points may include straight stretches where something
@@ -99,19 +139,21 @@ std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
 // `inlier_fraction` reports how much of the outline the final circle explains.
 std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlier_fraction) {
   std::optional<ArcFit> fit = FitCircle(points);
-  std::vector<cv::Point> inliers = points;
+  thread_local std::vector<cv::Point> inliers, kept;
+  inliers = points;
   for (int round = 0; fit && round < 3; ++round) {
     const double tolerance = std::max(1.5, 0.08 * fit->radius);
-    std::vector<cv::Point> kept;
+    kept.clear();
     for (const cv::Point& p : points) {
       const cv::Point2d d = cv::Point2d(p) - fit->centre;
       if (std::abs(std::hypot(d.x, d.y) - fit->radius) < tolerance) kept.push_back(p);
     }
     if (kept.size() == inliers.size() || kept.size() < 8) break;
-    inliers = std::move(kept);
+    std::swap(inliers, kept);
     fit = FitCircle(inliers);
   }
   *inlier_fraction = points.empty() ? 0.0 : static_cast<double>(inliers.size()) / points.size();
+  if (fit) MeasureArc(inliers, &*fit);
   return fit;
 }
 
