@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -45,6 +46,50 @@ double MedianDepthMm(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rec
   }
   if (readings.empty()) return 0.0;
   return MedianReading(readings);
+}
+
+// The area of the convex hull of an outline, exactly what cv::contourArea gives for its
+// cv::convexHull (both are exact on integer points), without the sort of every point: the hull
+// of an outline is the hull of the leftmost and rightmost point of each of its rows. `box`:
+// the outline's bounding rectangle.
+double ConvexHullArea(const std::vector<cv::Point>& outline, const cv::Rect& box) {
+  thread_local std::vector<int> left, right;
+  thread_local std::vector<cv::Point> ends, hull;
+  left.assign(box.height, std::numeric_limits<int>::max());
+  right.assign(box.height, std::numeric_limits<int>::min());
+  for (const cv::Point& p : outline) {
+    const int row = p.y - box.y;
+    left[row] = std::min(left[row], p.x);
+    right[row] = std::max(right[row], p.x);
+  }
+  // Sorted by row, then column: Andrew's monotone chain, both halves in one list.
+  ends.clear();
+  for (int row = 0; row < box.height; ++row) {
+    if (left[row] > right[row]) continue;
+    ends.emplace_back(left[row], box.y + row);
+    if (right[row] != left[row]) ends.emplace_back(right[row], box.y + row);
+  }
+  if (ends.size() < 3) return 0.0;
+  const auto cross = [](const cv::Point& o, const cv::Point& a, const cv::Point& b) {
+    return static_cast<int64_t>(a.x - o.x) * (b.y - o.y) -
+           static_cast<int64_t>(a.y - o.y) * (b.x - o.x);
+  };
+  hull.assign(2 * ends.size(), cv::Point());
+  size_t k = 0;
+  for (size_t i = 0; i < ends.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], ends[i]) <= 0) --k;
+    hull[k++] = ends[i];
+  }
+  for (size_t i = ends.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], ends[i]) <= 0) --k;
+    hull[k++] = ends[i];
+  }
+  int64_t twice_area = 0;  // shoelace, exact in 64 bits
+  for (size_t i = 0; i + 1 < k; ++i) {
+    twice_area += static_cast<int64_t>(hull[i].x) * hull[i + 1].y -
+                  static_cast<int64_t>(hull[i].y) * hull[i + 1].x;
+  }
+  return std::abs(static_cast<double>(twice_area)) * 0.5;
 }
 
 // A circle fitted (algebraic least squares, Kasa) to outline points.
@@ -418,7 +463,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       ++st.blobs;
       // The blob, filled (highlights and reflections inside it are part of the object), in
       // a padded window of its own.
-      const cv::Rect box = cv::boundingRect(blob) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+      const cv::Rect blob_box = cv::boundingRect(blob);
+      const cv::Rect box = blob_box & cv::Rect(0, 0, bgr.cols, bgr.rows);
       const cv::Rect window =
           (box + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
       cv::Mat blob_mask(window.size(), CV_8UC1, cv::Scalar(0));
@@ -465,17 +511,11 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         }
       }
 
-      // The blob's own outline (not cuts, not the image border): where arcs of objects show.
-      cv::Mat outline(window.size(), CV_8UC1, cv::Scalar(0));
-      for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
-      cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
       const bool all_round =
           std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
       // Touching objects: one piece each. A blob that fills its convex hull is one object
       // (two balls overlapping by 45 % of a diameter still fill only 97.8 %).
-      std::vector<cv::Point> hull;
-      cv::convexHull(blob, hull);
       // Kinds that are not round (rings, cubes, stars, blocks) have concave outlines of their
       // own: with depth, when none of the colour's kinds is round, a blob no wider and no
       // taller than one of them can look (its diagonal) is that one object, never cut.
@@ -484,8 +524,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       const bool one_object = none_round && largest_extent_px > 0.0 &&
                               box.width <= largest_extent_px + options.extent_margin_px &&
                               box.height <= largest_extent_px + options.extent_margin_px;
-      const bool convex =
-          one_object || blob_area >= options.single_object_solidity * cv::contourArea(hull);
+      const bool convex = one_object || blob_area >= options.single_object_solidity *
+                                                         ConvexHullArea(blob, blob_box);
       SeparationResult separated;
       if (convex) {
         std::vector<cv::Point> shifted = blob;
@@ -510,6 +550,15 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         separated = SeparateTouching(blob_mask, options.separation, options.separation_options);
       }
       const bool split = separated.pieces.size() > 1;
+      // The blob's own outline (not cuts, not the image border): where arcs of objects show.
+      // Not needed for the blob itself, the one piece of a blob left whole: every point of it
+      // is on the outline.
+      cv::Mat outline;
+      if (all_round && !convex) {
+        outline = cv::Mat(window.size(), CV_8UC1, cv::Scalar(0));
+        for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
+        cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
+      }
       for (std::vector<cv::Point> piece : separated.pieces) {
         ++st.pieces;
         for (cv::Point& p : piece) p += window.tl();
@@ -532,7 +581,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             const cv::Point local = p - window.tl();
             const bool on_border =
                 p.x <= 1 || p.y <= 1 || p.x >= bgr.cols - 2 || p.y >= bgr.rows - 2;
-            if (!on_border && outline.at<uint8_t>(local)) arc.push_back(p);
+            if (!on_border && (convex || outline.at<uint8_t>(local))) arc.push_back(p);
           }
           double inliers = 0.0;
           const std::optional<ArcFit> fit = FitArc(arc, &inliers);
