@@ -35,17 +35,19 @@ void CheckInput(const cv::Mat& bgr, const cv::Mat& depth_mm) {
 
 // Median of the valid depth readings under a mask, raw millimetres; 0 when none.
 double MedianDepthMm(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box) {
-  std::vector<uint16_t> readings;
-  readings.reserve(box.area());
+  thread_local std::vector<uint16_t> readings;  // reused: no allocation per blob
+  if (readings.size() < static_cast<size_t>(box.area())) readings.resize(box.area());
+  size_t count = 0;
   for (int v = box.y; v < box.y + box.height; ++v) {
     const uint8_t* m = mask.ptr<uint8_t>(v);
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
     for (int u = box.x; u < box.x + box.width; ++u) {
-      if (m[u] && d[u]) readings.push_back(d[u]);
+      readings[count] = d[u];
+      count += (m[u] != 0) & (d[u] != 0);
     }
   }
-  if (readings.empty()) return 0.0;
-  return MedianReading(readings);
+  if (count == 0) return 0.0;
+  return MedianReading(readings.data(), count);
 }
 
 // The area of the convex hull of an outline, exactly what cv::contourArea gives for its
