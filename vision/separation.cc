@@ -422,28 +422,33 @@ SeparationResult SeparateByDefects(const cv::Mat& binary, const SeparationOption
   // Holes are gaps enclosed by a ring of touching balls (or reflections inside one): fill
   // them so that cuts may cross them.
   cv::Mat work = cv::Mat::zeros(binary.size(), CV_8U);
-  const std::vector<Contour> blobs = ExternalContours(binary);
+  std::vector<Contour> blobs = ExternalContours(binary);
+  const size_t blob_count = blobs.size();
   cv::drawContours(work, blobs, -1, cv::Scalar(255), cv::FILLED);
   // Each piece is measured against the (filled) blob it came from. One blob (a detector's
   // window) fills one 8-connected region: its area is the pixel count, no labelling needed.
   cv::Mat labels, stats, centroids;
   double single_blob_area = 0.0;
-  if (blobs.size() == 1) {
+  if (blob_count == 1) {
     single_blob_area = static_cast<double>(cv::countNonZero(work));
   } else {
     cv::connectedComponentsWithStats(work, labels, stats, centroids, 8, CV_32S);
   }
   auto blob_area = [&](const Contour& piece) {
-    if (blobs.size() == 1) return single_blob_area;
+    if (blob_count == 1) return single_blob_area;
     return static_cast<double>(stats.at<int>(labels.at<int>(piece.front()), cv::CC_STAT_AREA));
   };
   // The outlines of `work` as it is now: after a pass that cuts nothing they are the final ones.
+  // Filling changed nothing (no holes, the usual case): they are the blobs' own outlines.
   std::vector<Contour> contours;
   bool contours_current = false;
+  const bool filled_is_binary = binary.isContinuous() && work.isContinuous() &&
+                                std::equal(binary.datastart, binary.dataend, work.datastart);
+  if (filled_is_binary) contours = std::move(blobs), contours_current = true;
   for (int pass = 0; pass < options.max_passes; ++pass) {
     // Find every blob's cut first, then draw them: one cut per blob per pass.
     std::vector<Cut> cuts;
-    contours = ExternalContours(work);
+    if (!contours_current) contours = ExternalContours(work);
     contours_current = true;
     for (const Contour& contour : contours) {
       const double min_piece_area_px = options.min_piece_area_ratio * blob_area(contour);
