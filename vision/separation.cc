@@ -89,10 +89,43 @@ std::optional<cv::Point2d> MomentCentroid(const Contour& contour) {
   return cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
 }
 
+// The points of an outline that can lie on its convex hull, in the outline's order: those
+// that are the leftmost or rightmost of their row (or on the top or bottom row, a convex
+// outline's only horizontal edges) and the topmost or bottommost of their column (or on the
+// leftmost or rightmost column, its only vertical edges). The rest are inside the hull, and
+// cv::convexHull (which starts the hull where the input's order says) gives the same hull
+// for these as for the whole outline.
+const Contour& HullCandidates(const Contour& contour) {
+  thread_local Contour candidates;
+  thread_local std::vector<int> left, right, top, bottom;
+  const cv::Rect box = cv::boundingRect(contour);
+  left.assign(box.height, std::numeric_limits<int>::max());
+  right.assign(box.height, std::numeric_limits<int>::min());
+  top.assign(box.width, std::numeric_limits<int>::max());
+  bottom.assign(box.width, std::numeric_limits<int>::min());
+  for (const cv::Point& p : contour) {
+    const int row = p.y - box.y, column = p.x - box.x;
+    left[row] = std::min(left[row], p.x);
+    right[row] = std::max(right[row], p.x);
+    top[column] = std::min(top[column], p.y);
+    bottom[column] = std::max(bottom[column], p.y);
+  }
+  candidates.clear();
+  for (const cv::Point& p : contour) {
+    const int row = p.y - box.y, column = p.x - box.x;
+    const bool row_end = row == 0 || row == box.height - 1 || p.x == left[row] || p.x == right[row];
+    const bool column_end =
+        column == 0 || column == box.width - 1 || p.y == top[column] || p.y == bottom[column];
+    if (row_end && column_end) candidates.push_back(p);
+  }
+  return candidates;
+}
+
 // `centroid`: MomentCentroid(contour), when the caller has it already.
 BlobFrame FrameOf(const Contour& contour, const std::optional<cv::Point2d>& centroid) {
   BlobFrame frame;
-  const cv::RotatedRect rect = cv::minAreaRect(contour);
+  // The min-area rectangle is found on the convex hull: its candidate points are enough.
+  const cv::RotatedRect rect = cv::minAreaRect(HullCandidates(contour));
   cv::Point2f corners[4];
   rect.points(corners);
   const cv::Point2d side_a = corners[1] - corners[0], side_b = corners[2] - corners[1];
