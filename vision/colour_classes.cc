@@ -140,6 +140,59 @@ std::vector<ColourClass> LoadColourClasses(const std::string& path) {
   return out;
 }
 
+namespace {
+
+// One channel's window [lo, hi] as cv::inRange takes it for an 8-bit image: each bound rounded
+// to the nearest integer (cvRound), an empty or out-of-range window matching nothing, the
+// rest saturated to 0..255. `in[v]` gets `bit` for every value v in the window.
+void MarkWindow(double lo, double hi, uint32_t bit, uint32_t in[256]) {
+  const int l = cvRound(lo), h = cvRound(hi);
+  if (l > h || l > 255 || h < 0) return;
+  for (int v = std::max(l, 0); v <= std::min(h, 255); ++v) in[v] |= bit;
+}
+
+}  // namespace
+
+std::vector<cv::Mat> ThresholdHsv(const cv::Mat& hsv, const std::vector<ColourClass>& colours) {
+  std::vector<cv::Mat> masks;
+  if (colours.size() > 32 || hsv.type() != CV_8UC3) {
+    for (const ColourClass& c : colours) masks.push_back(ThresholdHsv(hsv, c));
+    return masks;
+  }
+  // Per channel value, the classes (one bit each) whose window holds it: the windows of
+  // ThresholdHsv's cv::inRange calls, a wrapping hue window as its two halves.
+  uint32_t hue_in[256] = {}, saturation_in[256] = {}, value_in[256] = {};
+  for (size_t j = 0; j < colours.size(); ++j) {
+    const ColourClass& colour = colours[j];
+    const uint32_t bit = 1u << j;
+    const double lo_deg = colour.hue_deg - colour.hue_tolerance_deg;
+    const double hi_deg = colour.hue_deg + colour.hue_tolerance_deg;
+    if (lo_deg < 0.0 || hi_deg >= 360.0) {
+      const double a = lo_deg < 0.0 ? lo_deg + 360.0 : lo_deg;
+      const double b = hi_deg >= 360.0 ? hi_deg - 360.0 : hi_deg;
+      MarkWindow(a / 2.0, 180.0, bit, hue_in);
+      MarkWindow(0.0, b / 2.0, bit, hue_in);
+    } else {
+      MarkWindow(lo_deg / 2.0, hi_deg / 2.0, bit, hue_in);
+    }
+    MarkWindow(colour.min_saturation, 255.0, bit, saturation_in);
+    MarkWindow(colour.min_value, 255.0, bit, value_in);
+  }
+  for (size_t j = 0; j < colours.size(); ++j) masks.emplace_back(hsv.size(), CV_8UC1);
+  std::vector<uint8_t*> rows(colours.size());
+  for (int v = 0; v < hsv.rows; ++v) {
+    const uint8_t* p = hsv.ptr<uint8_t>(v);
+    for (size_t j = 0; j < colours.size(); ++j) rows[j] = masks[j].ptr<uint8_t>(v);
+    for (int u = 0; u < hsv.cols; ++u, p += 3) {
+      const uint32_t in = hue_in[p[0]] & saturation_in[p[1]] & value_in[p[2]];
+      for (size_t j = 0; j < colours.size(); ++j) {
+        rows[j][u] = static_cast<uint8_t>(-static_cast<int>((in >> j) & 1u));
+      }
+    }
+  }
+  return masks;
+}
+
 cv::Mat ThresholdHsv(const cv::Mat& hsv, const ColourClass& colour) {
   // OpenCV 8-bit hue is degrees / 2. The window may wrap around 0 (red).
   const double lo_deg = colour.hue_deg - colour.hue_tolerance_deg;

@@ -408,7 +408,7 @@ std::vector<cv::Mat> ColourMasks(const cv::Mat& bgr, const DetectorSetup& setup,
   if (options.method == DetectMethod::kThreshold) {
     cv::Mat hsv;
     cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
-    for (const ColourClass& c : setup.colours) masks.push_back(ThresholdHsv(hsv, c));
+    masks = ThresholdHsv(hsv, setup.colours);
   } else {
     std::vector<int> cluster_class;
     cv::Size small_size;
