@@ -94,6 +94,77 @@ double ConvexHullArea(const std::vector<cv::Point>& outline, const cv::Rect& box
   return std::abs(static_cast<double>(twice_area)) * 0.5;
 }
 
+// Morphology of a binary (0/255) mask with a kernel whose rows are each one run of ones
+// centred on the anchor column (an ellipse), exactly as cv::dilate / cv::erode with their
+// default border (pixels beyond the image take no part): each kernel row is a horizontal
+// max (min) over its half-width, and the rows are combined by a vertical max (min). The
+// same maxima (minima) of the same pixels, with a few passes per row instead of one per
+// kernel element. False (nothing done) for any other kernel.
+bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, bool dilate, cv::Mat* dst) {
+  if (src.type() != CV_8UC1 || kernel.type() != CV_8UC1 || kernel.cols % 2 == 0) return false;
+  const int centre = kernel.cols / 2, anchor_row = kernel.rows / 2;
+  std::vector<int> half(kernel.rows, -1);  // per kernel row: half-width, -1 if empty
+  for (int i = 0; i < kernel.rows; ++i) {
+    const uint8_t* k = kernel.ptr<uint8_t>(i);
+    int first = -1, last = -1;
+    for (int j = 0; j < kernel.cols; ++j) {
+      if (k[j]) {
+        if (first < 0) first = j;
+        if (last >= 0 && last != j - 1) return false;  // not one run
+        last = j;
+      }
+    }
+    if (first < 0) continue;
+    if (centre - first != last - centre) return false;  // not centred
+    half[i] = centre - first;
+  }
+  const int rows = src.rows, cols = src.cols;
+  const uint8_t neutral = dilate ? 0 : 255;
+  const auto op = [dilate](uint8_t a, uint8_t b) -> uint8_t {
+    return dilate ? std::max(a, b) : std::min(a, b);
+  };
+  const int widest = *std::max_element(half.begin(), half.end());
+  // horizontal[w]: each row's max (min) over [x - w, x + w].
+  thread_local std::vector<std::vector<uint8_t>> horizontal;
+  if (static_cast<int>(horizontal.size()) < widest + 1) horizontal.resize(widest + 1);
+  for (int w = 0; w <= widest; ++w) horizontal[w].resize(static_cast<size_t>(rows) * cols);
+  for (int y = 0; y < rows; ++y) std::copy_n(src.ptr<uint8_t>(y), cols, &horizontal[0][y * cols]);
+  for (int w = 1; w <= widest; ++w) {
+    for (int y = 0; y < rows; ++y) {
+      const uint8_t* in = &horizontal[w - 1][y * cols];
+      uint8_t* out = &horizontal[w][y * cols];
+      for (int x = 0; x < cols; ++x) {
+        const uint8_t left = x > 0 ? in[x - 1] : neutral;
+        const uint8_t right = x + 1 < cols ? in[x + 1] : neutral;
+        out[x] = op(op(left, in[x]), right);
+      }
+    }
+  }
+  cv::Mat out(rows, cols, CV_8UC1);
+  for (int y = 0; y < rows; ++y) {
+    uint8_t* o = out.ptr<uint8_t>(y);
+    std::fill_n(o, cols, neutral);
+    for (int i = 0; i < kernel.rows; ++i) {
+      const int from = y + i - anchor_row;
+      if (half[i] < 0 || from < 0 || from >= rows) continue;
+      const uint8_t* in = &horizontal[half[i]][from * cols];
+      for (int x = 0; x < cols; ++x) o[x] = op(o[x], in[x]);
+    }
+  }
+  *dst = out;
+  return true;
+}
+
+// cv::morphologyEx(MORPH_CLOSE) of a binary mask, by SpanMorphology when the kernel allows.
+void CloseBinary(cv::Mat* mask, const cv::Mat& kernel) {
+  cv::Mat dilated;
+  if (SpanMorphology(*mask, kernel, true, &dilated) &&
+      SpanMorphology(dilated, kernel, false, mask)) {
+    return;
+  }
+  cv::morphologyEx(*mask, *mask, cv::MORPH_CLOSE, kernel);
+}
+
 // A circle fitted (algebraic least squares, Kasa) to outline points.
 struct ArcFit {
   cv::Point2d centre;
@@ -507,8 +578,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           if (options.method == DetectMethod::kKMeans && expected_radius_px > 6.0) {
             const int k = std::max(3, static_cast<int>(0.15 * expected_radius_px) | 1);
             blob_mask_is_fill = false;
-            cv::morphologyEx(blob_mask, blob_mask, cv::MORPH_CLOSE,
-                             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+            CloseBinary(&blob_mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
           }
         }
       }
