@@ -314,6 +314,8 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
   // Chromatic pixels only: greys (floor, walls, white reflections) carry no hue.
   std::vector<cv::Vec2f> samples;
   std::vector<int> index;
+  samples.reserve(lab.total());
+  index.reserve(lab.total());
   const float min_chroma2 =
       static_cast<float>(options.kmeans_min_chroma * options.kmeans_min_chroma);
   for (int v = 0; v < lab.rows; ++v) {
@@ -343,11 +345,17 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
                               options.kmeans_iterations, 0.5),
              1, cv::KMEANS_PP_CENTERS, centres);
   std::vector<int> labels(samples.size());
+  std::vector<float> centre_a(k), centre_b(k);  // read once, not through cv::Mat::at per sample
+  for (int c = 0; c < k; ++c) {
+    centre_a[c] = centres.at<float>(c, 0);
+    centre_b[c] = centres.at<float>(c, 1);
+  }
   for (size_t s = 0; s < samples.size(); ++s) {
     float best = std::numeric_limits<float>::infinity();
+    const float a = samples[s][0], b = samples[s][1];
     for (int c = 0; c < k; ++c) {
-      const float dx = samples[s][0] - centres.at<float>(c, 0);
-      const float dy = samples[s][1] - centres.at<float>(c, 1);
+      const float dx = a - centre_a[c];
+      const float dy = b - centre_b[c];
       const float d2 = dx * dx + dy * dy;
       if (d2 < best) best = d2, labels[s] = c;
     }
@@ -367,9 +375,8 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
       if (diff < best) best = diff, (*cluster_class)[c] = j < targets ? static_cast<int>(j) : -1;
     }
   }
-  for (size_t s = 0; s < index.size(); ++s) {
-    labels_small.at<int>(index[s] / small.cols, index[s] % small.cols) = labels[s];
-  }
+  int* label_of = labels_small.ptr<int>();  // continuous: index is v * cols + u
+  for (size_t s = 0; s < index.size(); ++s) label_of[index[s]] = labels[s];
   return labels_small;
 }
 
