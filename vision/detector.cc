@@ -629,11 +629,17 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         separated = SeparateTouching(blob_mask, options.separation, options.separation_options);
       }
       const bool split = separated.pieces.size() > 1;
+      // Left whole: the one piece is the blob's own outline (convex, or nothing to cut).
+      const bool whole =
+          convex ||
+          (separated.pieces.size() == 1 &&
+           std::equal(
+               blob.begin(), blob.end(), separated.pieces[0].begin(), separated.pieces[0].end(),
+               [&](const cv::Point& b, const cv::Point& p) { return b == p + window.tl(); }));
       // The blob's own outline (not cuts, not the image border): where arcs of objects show.
-      // Not needed for the blob itself, the one piece of a blob left whole: every point of it
-      // is on the outline.
+      // Not needed for a blob left whole: every point of its piece is on the outline.
       cv::Mat outline;
-      if (all_round && !convex) {
+      if (all_round && !whole) {
         outline = cv::Mat(window.size(), CV_8UC1, cv::Scalar(0));
         for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
         cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
@@ -660,7 +666,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             const cv::Point local = p - window.tl();
             const bool on_border =
                 p.x <= 1 || p.y <= 1 || p.x >= bgr.cols - 2 || p.y >= bgr.rows - 2;
-            if (!on_border && (convex || outline.at<uint8_t>(local))) arc.push_back(p);
+            if (!on_border && (whole || outline.at<uint8_t>(local))) arc.push_back(p);
           }
           double inliers = 0.0;
           const std::optional<ArcFit> fit = FitArc(arc, &inliers);
@@ -694,7 +700,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           const cv::Rect roi = (d.box + cv::Size(2 * pad, 2 * pad) - cv::Point(pad, pad)) &
                                cv::Rect(0, 0, bgr.cols, bgr.rows);
           cv::Mat piece_mask;
-          if (convex && blob_mask_is_fill && roi == window) {
+          if (whole && blob_mask_is_fill && roi == window) {
             piece_mask = blob_mask;  // the same contour filled in the same window: no redraw
           } else {
             piece_mask = cv::Mat(roi.size(), CV_8UC1, cv::Scalar(0));
