@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/contour_fill.h"
 #include "vision/field_gate.h"
 
 namespace slamo::vision {
@@ -548,8 +549,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       const cv::Rect window =
           (box + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
       cv::Mat blob_mask(window.size(), CV_8UC1, cv::Scalar(0));
-      cv::drawContours(blob_mask, std::vector<std::vector<cv::Point>>{blob}, 0, cv::Scalar(255),
-                       cv::FILLED, cv::LINE_8, cv::noArray(), 0, -window.tl());
+      FillOutline(blob, -window.tl(), &blob_mask);
       bool blob_mask_is_fill = true;  // until a closing changes it
 
       // At its depth, how big should it be? Too small for every kind: noise (not eroded
@@ -704,8 +704,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             piece_mask = blob_mask;  // the same contour filled in the same window: no redraw
           } else {
             piece_mask = cv::Mat(roi.size(), CV_8UC1, cv::Scalar(0));
-            cv::drawContours(piece_mask, std::vector<std::vector<cv::Point>>{piece}, 0,
-                             cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0, -roi.tl());
+            FillOutline(piece, -roi.tl(), &piece_mask);
           }
           const cv::Mat depth_roi = depth_mm(roi);
           // The kind whose size fits best.

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "platform/drive_base.h"
+#include "vision/contour_fill.h"
 
 namespace slamo::vision {
 namespace {
@@ -457,7 +458,7 @@ SeparationResult SeparateByDefects(const cv::Mat& binary, const SeparationOption
   cv::Mat work = cv::Mat::zeros(binary.size(), CV_8U);
   std::vector<Contour> blobs = ExternalContours(binary);
   const size_t blob_count = blobs.size();
-  cv::drawContours(work, blobs, -1, cv::Scalar(255), cv::FILLED);
+  FillOutlines(blobs, cv::Point(), &work);
   // Each piece is measured against the (filled) blob it came from. One blob (a detector's
   // window) fills one 8-connected region: its area is the pixel count, no labelling needed.
   cv::Mat labels, stats, centroids;
