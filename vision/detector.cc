@@ -95,13 +95,14 @@ double ConvexHullArea(const std::vector<cv::Point>& outline, const cv::Rect& box
   return std::abs(static_cast<double>(twice_area)) * 0.5;
 }
 
-// Morphology of a binary (0/255) mask with a kernel whose rows are each one run of ones
-// centred on the anchor column (an ellipse), exactly as cv::dilate / cv::erode with their
-// default border (pixels beyond the image take no part): each kernel row is a horizontal
-// max (min) over its half-width, and the rows are combined by a vertical max (min). The
-// same maxima (minima) of the same pixels, with a few passes per row instead of one per
-// kernel element. False (nothing done) for any other kernel.
-bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, bool dilate, cv::Mat* dst) {
+// Morphology of an 8-bit mask with a kernel whose rows are each one run of ones centred on
+// the anchor column (an ellipse), exactly as cv::dilate / cv::erode with their default
+// border (pixels beyond the image take no part): each kernel row is a horizontal max (min)
+// over its half-width, and the rows are combined by a vertical max (min). The same maxima
+// (minima) of the same pixels, with a few passes per row instead of one per kernel element.
+// False (nothing done) for any other kernel.
+template <bool kDilate>
+bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, cv::Mat* dst) {
   if (src.type() != CV_8UC1 || kernel.type() != CV_8UC1 || kernel.cols % 2 == 0) return false;
   const int centre = kernel.cols / 2, anchor_row = kernel.rows / 2;
   std::vector<int> half(kernel.rows, -1);  // per kernel row: half-width, -1 if empty
@@ -120,12 +121,11 @@ bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, bool dilate, cv::
     half[i] = centre - first;
   }
   const int rows = src.rows, cols = src.cols;
-  const uint8_t neutral = dilate ? 0 : 255;
-  const auto op = [dilate](uint8_t a, uint8_t b) -> uint8_t {
-    return dilate ? std::max(a, b) : std::min(a, b);
+  const auto op = [](uint8_t a, uint8_t b) -> uint8_t {
+    return kDilate ? std::max(a, b) : std::min(a, b);
   };
   const int widest = *std::max_element(half.begin(), half.end());
-  // horizontal[w]: each row's max (min) over [x - w, x + w].
+  // horizontal[w]: each row's max (min) over [x - w, x + w] (within the row).
   thread_local std::vector<std::vector<uint8_t>> horizontal;
   if (static_cast<int>(horizontal.size()) < widest + 1) horizontal.resize(widest + 1);
   for (int w = 0; w <= widest; ++w) horizontal[w].resize(static_cast<size_t>(rows) * cols);
@@ -134,17 +134,18 @@ bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, bool dilate, cv::
     for (int y = 0; y < rows; ++y) {
       const uint8_t* in = &horizontal[w - 1][y * cols];
       uint8_t* out = &horizontal[w][y * cols];
-      for (int x = 0; x < cols; ++x) {
-        const uint8_t left = x > 0 ? in[x - 1] : neutral;
-        const uint8_t right = x + 1 < cols ? in[x + 1] : neutral;
-        out[x] = op(op(left, in[x]), right);
+      if (cols == 1) {
+        out[0] = in[0];
+        continue;
       }
+      out[0] = op(in[0], in[1]);
+      for (int x = 1; x + 1 < cols; ++x) out[x] = op(op(in[x - 1], in[x]), in[x + 1]);
+      out[cols - 1] = op(in[cols - 2], in[cols - 1]);
     }
   }
-  cv::Mat out(rows, cols, CV_8UC1);
+  cv::Mat out(rows, cols, CV_8UC1, cv::Scalar(kDilate ? 0 : 255));
   for (int y = 0; y < rows; ++y) {
     uint8_t* o = out.ptr<uint8_t>(y);
-    std::fill_n(o, cols, neutral);
     for (int i = 0; i < kernel.rows; ++i) {
       const int from = y + i - anchor_row;
       if (half[i] < 0 || from < 0 || from >= rows) continue;
@@ -159,8 +160,8 @@ bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, bool dilate, cv::
 // cv::morphologyEx(MORPH_CLOSE) of a binary mask, by SpanMorphology when the kernel allows.
 void CloseBinary(cv::Mat* mask, const cv::Mat& kernel) {
   cv::Mat dilated;
-  if (SpanMorphology(*mask, kernel, true, &dilated) &&
-      SpanMorphology(dilated, kernel, false, mask)) {
+  if (SpanMorphology<true>(*mask, kernel, &dilated) &&
+      SpanMorphology<false>(dilated, kernel, mask)) {
     return;
   }
   cv::morphologyEx(*mask, *mask, cv::MORPH_CLOSE, kernel);
