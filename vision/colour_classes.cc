@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "field_configs/config_error.h"
@@ -138,6 +139,96 @@ std::vector<ColourClass> LoadColourClasses(const std::string& path) {
   }
   if (out.empty()) fail(root["colours"], "colours", "at least one colour");
   return out;
+}
+
+namespace {
+
+// One channel's window [lo, hi] as cv::inRange takes it for an 8-bit image: each bound rounded
+// to the nearest integer (cvRound), an empty or out-of-range window matching nothing, the
+// rest saturated to 0..255. A value x is in it when (x - lo) mod 256 <= span.
+struct ByteWindow {
+  bool empty = true;
+  uint8_t lo = 0, span = 0;
+};
+
+ByteWindow InRangeWindow(double lo, double hi) {
+  const int l = cvRound(lo), h = cvRound(hi);
+  if (l > h || l > 255 || h < 0) return {};
+  const int first = std::max(l, 0), last = std::min(h, 255);
+  return {false, static_cast<uint8_t>(first), static_cast<uint8_t>(last - first)};
+}
+
+// A class's windows: hue (a wrapping window as its two halves), saturation and value.
+struct HsvWindows {
+  ByteWindow hue[2], saturation, value;
+};
+
+HsvWindows WindowsOf(const ColourClass& colour) {
+  // As ThresholdHsv below: OpenCV 8-bit hue is degrees / 2, the window may wrap around 0.
+  HsvWindows w;
+  const double lo_deg = colour.hue_deg - colour.hue_tolerance_deg;
+  const double hi_deg = colour.hue_deg + colour.hue_tolerance_deg;
+  if (lo_deg < 0.0 || hi_deg >= 360.0) {
+    const double a = lo_deg < 0.0 ? lo_deg + 360.0 : lo_deg;
+    const double b = hi_deg >= 360.0 ? hi_deg - 360.0 : hi_deg;
+    w.hue[0] = InRangeWindow(a / 2.0, 180.0);
+    w.hue[1] = InRangeWindow(0.0, b / 2.0);
+  } else {
+    w.hue[0] = InRangeWindow(lo_deg / 2.0, hi_deg / 2.0);
+  }
+  w.saturation = InRangeWindow(colour.min_saturation, 255.0);
+  w.value = InRangeWindow(colour.min_value, 255.0);
+  return w;
+}
+
+bool In(const ByteWindow& w, uint8_t x) {
+  return !w.empty && static_cast<uint8_t>(x - w.lo) <= w.span;
+}
+
+#if CV_SIMD128
+// 255 in each lane whose byte is in the window.
+cv::v_uint8x16 In(const ByteWindow& w, const cv::v_uint8x16& x) {
+  if (w.empty) return cv::v_setzero_u8();
+  return cv::v_sub_wrap(x, cv::v_setall_u8(w.lo)) <= cv::v_setall_u8(w.span);
+}
+#endif
+
+}  // namespace
+
+std::vector<cv::Mat> ThresholdHsv(const cv::Mat& hsv, const std::vector<ColourClass>& colours) {
+  std::vector<cv::Mat> masks;
+  if (hsv.type() != CV_8UC3) {
+    for (const ColourClass& c : colours) masks.push_back(ThresholdHsv(hsv, c));
+    return masks;
+  }
+  // The windows of ThresholdHsv's cv::inRange calls; a pixel is in a class when its hue is in
+  // either hue window (the OR of the two calls) and its saturation and value in theirs.
+  std::vector<HsvWindows> windows;
+  for (const ColourClass& c : colours) windows.push_back(WindowsOf(c));
+  for (size_t j = 0; j < colours.size(); ++j) masks.emplace_back(hsv.size(), CV_8UC1);
+  for (int v = 0; v < hsv.rows; ++v) {
+    const uint8_t* p = hsv.ptr<uint8_t>(v);
+    for (size_t j = 0; j < windows.size(); ++j) {
+      const HsvWindows& w = windows[j];
+      uint8_t* m = masks[j].ptr<uint8_t>(v);
+      int u = 0;
+#if CV_SIMD128
+      for (; u + 16 <= hsv.cols; u += 16) {
+        cv::v_uint8x16 h, s, x;
+        cv::v_load_deinterleave(p + 3 * u, h, s, x);
+        cv::v_store(m + u,
+                    (In(w.hue[0], h) | In(w.hue[1], h)) & In(w.saturation, s) & In(w.value, x));
+      }
+#endif
+      for (; u < hsv.cols; ++u) {
+        const uint8_t* q = p + 3 * u;
+        const bool in = (In(w.hue[0], q[0]) || In(w.hue[1], q[0])) && In(w.saturation, q[1]) &&
+                        In(w.value, q[2]);
+        m[u] = in ? 255 : 0;
+      }
+    }
+  }
+  return masks;
 }
 
 cv::Mat ThresholdHsv(const cv::Mat& hsv, const ColourClass& colour) {

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/contour_fill.h"
 #include "vision/field_gate.h"
 
 namespace slamo::vision {
@@ -34,17 +36,135 @@ void CheckInput(const cv::Mat& bgr, const cv::Mat& depth_mm) {
 
 // Median of the valid depth readings under a mask, raw millimetres; 0 when none.
 double MedianDepthMm(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box) {
-  std::vector<uint16_t> readings;
-  readings.reserve(box.area());
+  thread_local std::vector<uint16_t> readings;  // reused: no allocation per blob
+  if (readings.size() < static_cast<size_t>(box.area())) readings.resize(box.area());
+  size_t count = 0;
   for (int v = box.y; v < box.y + box.height; ++v) {
     const uint8_t* m = mask.ptr<uint8_t>(v);
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
     for (int u = box.x; u < box.x + box.width; ++u) {
-      if (m[u] && d[u]) readings.push_back(d[u]);
+      readings[count] = d[u];
+      count += (m[u] != 0) & (d[u] != 0);
     }
   }
-  if (readings.empty()) return 0.0;
-  return MedianReading(readings);
+  if (count == 0) return 0.0;
+  return MedianReading(readings.data(), count);
+}
+
+// The area of the convex hull of an outline, exactly what cv::contourArea gives for its
+// cv::convexHull (both are exact on integer points), without the sort of every point: the hull
+// of an outline is the hull of the leftmost and rightmost point of each of its rows. `box`:
+// the outline's bounding rectangle.
+double ConvexHullArea(const std::vector<cv::Point>& outline, const cv::Rect& box) {
+  thread_local std::vector<int> left, right;
+  thread_local std::vector<cv::Point> ends, hull;
+  left.assign(box.height, std::numeric_limits<int>::max());
+  right.assign(box.height, std::numeric_limits<int>::min());
+  for (const cv::Point& p : outline) {
+    const int row = p.y - box.y;
+    left[row] = std::min(left[row], p.x);
+    right[row] = std::max(right[row], p.x);
+  }
+  // Sorted by row, then column: Andrew's monotone chain, both halves in one list.
+  ends.clear();
+  for (int row = 0; row < box.height; ++row) {
+    if (left[row] > right[row]) continue;
+    ends.emplace_back(left[row], box.y + row);
+    if (right[row] != left[row]) ends.emplace_back(right[row], box.y + row);
+  }
+  if (ends.size() < 3) return 0.0;
+  const auto cross = [](const cv::Point& o, const cv::Point& a, const cv::Point& b) {
+    return static_cast<int64_t>(a.x - o.x) * (b.y - o.y) -
+           static_cast<int64_t>(a.y - o.y) * (b.x - o.x);
+  };
+  hull.assign(2 * ends.size(), cv::Point());
+  size_t k = 0;
+  for (size_t i = 0; i < ends.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], ends[i]) <= 0) --k;
+    hull[k++] = ends[i];
+  }
+  for (size_t i = ends.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], ends[i]) <= 0) --k;
+    hull[k++] = ends[i];
+  }
+  int64_t twice_area = 0;  // shoelace, exact in 64 bits
+  for (size_t i = 0; i + 1 < k; ++i) {
+    twice_area += static_cast<int64_t>(hull[i].x) * hull[i + 1].y -
+                  static_cast<int64_t>(hull[i].y) * hull[i + 1].x;
+  }
+  return std::abs(static_cast<double>(twice_area)) * 0.5;
+}
+
+// Morphology of an 8-bit mask with a kernel whose rows are each one run of ones centred on
+// the anchor column (an ellipse), exactly as cv::dilate / cv::erode with their default
+// border (pixels beyond the image take no part): each kernel row is a horizontal max (min)
+// over its half-width, and the rows are combined by a vertical max (min). The same maxima
+// (minima) of the same pixels, with a few passes per row instead of one per kernel element.
+// False (nothing done) for any other kernel.
+template <bool kDilate>
+bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, cv::Mat* dst) {
+  if (src.type() != CV_8UC1 || kernel.type() != CV_8UC1 || kernel.cols % 2 == 0) return false;
+  const int centre = kernel.cols / 2, anchor_row = kernel.rows / 2;
+  std::vector<int> half(kernel.rows, -1);  // per kernel row: half-width, -1 if empty
+  for (int i = 0; i < kernel.rows; ++i) {
+    const uint8_t* k = kernel.ptr<uint8_t>(i);
+    int first = -1, last = -1;
+    for (int j = 0; j < kernel.cols; ++j) {
+      if (k[j]) {
+        if (first < 0) first = j;
+        if (last >= 0 && last != j - 1) return false;  // not one run
+        last = j;
+      }
+    }
+    if (first < 0) continue;
+    if (centre - first != last - centre) return false;  // not centred
+    half[i] = centre - first;
+  }
+  const int rows = src.rows, cols = src.cols;
+  const auto op = [](uint8_t a, uint8_t b) -> uint8_t {
+    return kDilate ? std::max(a, b) : std::min(a, b);
+  };
+  const int widest = *std::max_element(half.begin(), half.end());
+  // horizontal[w]: each row's max (min) over [x - w, x + w] (within the row).
+  thread_local std::vector<std::vector<uint8_t>> horizontal;
+  if (static_cast<int>(horizontal.size()) < widest + 1) horizontal.resize(widest + 1);
+  for (int w = 0; w <= widest; ++w) horizontal[w].resize(static_cast<size_t>(rows) * cols);
+  for (int y = 0; y < rows; ++y) std::copy_n(src.ptr<uint8_t>(y), cols, &horizontal[0][y * cols]);
+  for (int w = 1; w <= widest; ++w) {
+    for (int y = 0; y < rows; ++y) {
+      const uint8_t* in = &horizontal[w - 1][y * cols];
+      uint8_t* out = &horizontal[w][y * cols];
+      if (cols == 1) {
+        out[0] = in[0];
+        continue;
+      }
+      out[0] = op(in[0], in[1]);
+      for (int x = 1; x + 1 < cols; ++x) out[x] = op(op(in[x - 1], in[x]), in[x + 1]);
+      out[cols - 1] = op(in[cols - 2], in[cols - 1]);
+    }
+  }
+  cv::Mat out(rows, cols, CV_8UC1, cv::Scalar(kDilate ? 0 : 255));
+  for (int y = 0; y < rows; ++y) {
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int i = 0; i < kernel.rows; ++i) {
+      const int from = y + i - anchor_row;
+      if (half[i] < 0 || from < 0 || from >= rows) continue;
+      const uint8_t* in = &horizontal[half[i]][from * cols];
+      for (int x = 0; x < cols; ++x) o[x] = op(o[x], in[x]);
+    }
+  }
+  *dst = out;
+  return true;
+}
+
+// cv::morphologyEx(MORPH_CLOSE) of a binary mask, by SpanMorphology when the kernel allows.
+void CloseBinary(cv::Mat* mask, const cv::Mat& kernel) {
+  cv::Mat dilated;
+  if (SpanMorphology<true>(*mask, kernel, &dilated) &&
+      SpanMorphology<false>(dilated, kernel, mask)) {
+    return;
+  }
+  cv::morphologyEx(*mask, *mask, cv::MORPH_CLOSE, kernel);
 }
 
 // A circle fitted (algebraic least squares, Kasa) to outline points.
@@ -55,6 +175,8 @@ struct ArcFit {
   double coverage_deg = 0.0;  // 360 minus the largest angular gap between points
 };
 
+// The circle alone (centre and radius; rms and coverage are left 0): FitArc refits up to
+// four times and needs the statistics of the last fit only.
 std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   if (points.size() < 8) return std::nullopt;
   cv::Point2d mean(0, 0);
@@ -64,9 +186,10 @@ std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   cv::Mat a(n, 3, CV_64F), b(n, 1, CV_64F);
   for (int i = 0; i < n; ++i) {
     const double x = points[i].x - mean.x, y = points[i].y - mean.y;
-    a.at<double>(i, 0) = x;
-    a.at<double>(i, 1) = y;
-    a.at<double>(i, 2) = 1.0;
+    double* row = a.ptr<double>(i);
+    row[0] = x;
+    row[1] = y;
+    row[2] = 1.0;
     b.at<double>(i, 0) = -(x * x + y * y);
   }
   cv::Mat solution;
@@ -77,21 +200,58 @@ std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   ArcFit fit;
   fit.centre = mean + cv::Point2d(cx, cy);
   fit.radius = std::sqrt(r2);
-  std::vector<double> angles;
-  angles.reserve(points.size());
-  double sum2 = 0.0;
-  for (const cv::Point& p : points) {
-    const cv::Point2d d = cv::Point2d(p) - fit.centre;
-    const double e = std::hypot(d.x, d.y) - fit.radius;
-    sum2 += e * e;
-    angles.push_back(std::atan2(d.y, d.x));
-  }
-  fit.rms = std::sqrt(sum2 / points.size());
-  std::sort(angles.begin(), angles.end());
-  double gap = 2.0 * M_PI - (angles.back() - angles.front());
-  for (size_t i = 1; i < angles.size(); ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
-  fit.coverage_deg = 360.0 - gap * 180.0 / M_PI;
   return fit;
+}
+
+// The largest difference between consecutive values of `values` once sorted, without
+// sorting (the maximum-gap bucket method): the largest gap is at least (max - min) / (n - 1),
+// wider than a bucket of (max - min) / n, so it always lies between the highest value of one
+// non-empty bucket and the lowest of the next. The bucket index is monotonic in the value,
+// so those are consecutive values of the sorted order, and their difference is the same
+// double the sorted scan computes.
+double LargestSortedGap(const std::vector<double>& values) {
+  const size_t n = values.size();
+  if (n < 2) return 0.0;
+  const auto [lo_it, hi_it] = std::minmax_element(values.begin(), values.end());
+  const double lo = *lo_it, range = *hi_it - lo;
+  if (!(range > 0.0)) return 0.0;
+  thread_local std::vector<double> bucket_lo, bucket_hi;
+  bucket_lo.assign(n, std::numeric_limits<double>::infinity());
+  bucket_hi.assign(n, -std::numeric_limits<double>::infinity());
+  const double scale = static_cast<double>(n) / range;
+  for (const double v : values) {
+    const size_t k = std::min(n - 1, static_cast<size_t>((v - lo) * scale));
+    bucket_lo[k] = std::min(bucket_lo[k], v);
+    bucket_hi[k] = std::max(bucket_hi[k], v);
+  }
+  double gap = 0.0, previous_hi = bucket_hi[0];  // bucket 0 holds the minimum
+  for (size_t k = 1; k < n; ++k) {
+    if (bucket_lo[k] > bucket_hi[k]) continue;  // empty
+    gap = std::max(gap, bucket_lo[k] - previous_hi);
+    previous_hi = bucket_hi[k];
+  }
+  return gap;
+}
+
+// rms distance of the points to the fitted circle and its angular coverage.
+void MeasureArc(const std::vector<cv::Point>& points, ArcFit* fit) {
+  thread_local std::vector<double> angles;
+  angles.clear();
+  double sum2 = 0.0;
+  double lowest = std::numeric_limits<double>::infinity();
+  double highest = -std::numeric_limits<double>::infinity();
+  for (const cv::Point& p : points) {
+    const cv::Point2d d = cv::Point2d(p) - fit->centre;
+    const double e = std::hypot(d.x, d.y) - fit->radius;
+    sum2 += e * e;
+    const double angle = std::atan2(d.y, d.x);
+    angles.push_back(angle);
+    lowest = std::min(lowest, angle);
+    highest = std::max(highest, angle);
+  }
+  fit->rms = std::sqrt(sum2 / points.size());
+  const double gap = std::max(2.0 * M_PI - (highest - lowest), LargestSortedGap(angles));
+  fit->coverage_deg = 360.0 - gap * 180.0 / M_PI;
 }
 
 // A circle through an outline whose points may include straight stretches where something
@@ -99,19 +259,21 @@ std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
 // `inlier_fraction` reports how much of the outline the final circle explains.
 std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlier_fraction) {
   std::optional<ArcFit> fit = FitCircle(points);
-  std::vector<cv::Point> inliers = points;
+  thread_local std::vector<cv::Point> inliers, kept;
+  inliers = points;
   for (int round = 0; fit && round < 3; ++round) {
     const double tolerance = std::max(1.5, 0.08 * fit->radius);
-    std::vector<cv::Point> kept;
+    kept.clear();
     for (const cv::Point& p : points) {
       const cv::Point2d d = cv::Point2d(p) - fit->centre;
       if (std::abs(std::hypot(d.x, d.y) - fit->radius) < tolerance) kept.push_back(p);
     }
     if (kept.size() == inliers.size() || kept.size() < 8) break;
-    inliers = std::move(kept);
+    std::swap(inliers, kept);
     fit = FitCircle(inliers);
   }
   *inlier_fraction = points.empty() ? 0.0 : static_cast<double>(inliers.size()) / points.size();
+  if (fit) MeasureArc(inliers, &*fit);
   return fit;
 }
 
@@ -154,6 +316,8 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
   // Chromatic pixels only: greys (floor, walls, white reflections) carry no hue.
   std::vector<cv::Vec2f> samples;
   std::vector<int> index;
+  samples.reserve(lab.total());
+  index.reserve(lab.total());
   const float min_chroma2 =
       static_cast<float>(options.kmeans_min_chroma * options.kmeans_min_chroma);
   for (int v = 0; v < lab.rows; ++v) {
@@ -183,11 +347,17 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
                               options.kmeans_iterations, 0.5),
              1, cv::KMEANS_PP_CENTERS, centres);
   std::vector<int> labels(samples.size());
+  std::vector<float> centre_a(k), centre_b(k);  // read once, not through cv::Mat::at per sample
+  for (int c = 0; c < k; ++c) {
+    centre_a[c] = centres.at<float>(c, 0);
+    centre_b[c] = centres.at<float>(c, 1);
+  }
   for (size_t s = 0; s < samples.size(); ++s) {
     float best = std::numeric_limits<float>::infinity();
+    const float a = samples[s][0], b = samples[s][1];
     for (int c = 0; c < k; ++c) {
-      const float dx = samples[s][0] - centres.at<float>(c, 0);
-      const float dy = samples[s][1] - centres.at<float>(c, 1);
+      const float dx = a - centre_a[c];
+      const float dy = b - centre_b[c];
       const float d2 = dx * dx + dy * dy;
       if (d2 < best) best = d2, labels[s] = c;
     }
@@ -207,9 +377,8 @@ cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const Detec
       if (diff < best) best = diff, (*cluster_class)[c] = j < targets ? static_cast<int>(j) : -1;
     }
   }
-  for (size_t s = 0; s < index.size(); ++s) {
-    labels_small.at<int>(index[s] / small.cols, index[s] % small.cols) = labels[s];
-  }
+  int* label_of = labels_small.ptr<int>();  // continuous: index is v * cols + u
+  for (size_t s = 0; s < index.size(); ++s) label_of[index[s]] = labels[s];
   return labels_small;
 }
 
@@ -319,7 +488,7 @@ std::vector<cv::Mat> ColourMasks(const cv::Mat& bgr, const DetectorSetup& setup,
   if (options.method == DetectMethod::kThreshold) {
     cv::Mat hsv;
     cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
-    for (const ColourClass& c : setup.colours) masks.push_back(ThresholdHsv(hsv, c));
+    masks = ThresholdHsv(hsv, setup.colours);
   } else {
     std::vector<int> cluster_class;
     cv::Size small_size;
@@ -376,12 +545,12 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       ++st.blobs;
       // The blob, filled (highlights and reflections inside it are part of the object), in
       // a padded window of its own.
-      const cv::Rect box = cv::boundingRect(blob) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+      const cv::Rect blob_box = cv::boundingRect(blob);
+      const cv::Rect box = blob_box & cv::Rect(0, 0, bgr.cols, bgr.rows);
       const cv::Rect window =
           (box + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
       cv::Mat blob_mask(window.size(), CV_8UC1, cv::Scalar(0));
-      cv::drawContours(blob_mask, std::vector<std::vector<cv::Point>>{blob}, 0, cv::Scalar(255),
-                       cv::FILLED, cv::LINE_8, cv::noArray(), 0, -window.tl());
+      FillOutline(blob, -window.tl(), &blob_mask);
       bool blob_mask_is_fill = true;  // until a closing changes it
 
       // At its depth, how big should it be? Too small for every kind: noise (not eroded
@@ -417,23 +586,16 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           if (options.method == DetectMethod::kKMeans && expected_radius_px > 6.0) {
             const int k = std::max(3, static_cast<int>(0.15 * expected_radius_px) | 1);
             blob_mask_is_fill = false;
-            cv::morphologyEx(blob_mask, blob_mask, cv::MORPH_CLOSE,
-                             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+            CloseBinary(&blob_mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
           }
         }
       }
 
-      // The blob's own outline (not cuts, not the image border): where arcs of objects show.
-      cv::Mat outline(window.size(), CV_8UC1, cv::Scalar(0));
-      for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
-      cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
       const bool all_round =
           std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
       // Touching objects: one piece each. A blob that fills its convex hull is one object
       // (two balls overlapping by 45 % of a diameter still fill only 97.8 %).
-      std::vector<cv::Point> hull;
-      cv::convexHull(blob, hull);
       // Kinds that are not round (rings, cubes, stars, blocks) have concave outlines of their
       // own: with depth, when none of the colour's kinds is round, a blob no wider and no
       // taller than one of them can look (its diagonal) is that one object, never cut.
@@ -442,8 +604,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       const bool one_object = none_round && largest_extent_px > 0.0 &&
                               box.width <= largest_extent_px + options.extent_margin_px &&
                               box.height <= largest_extent_px + options.extent_margin_px;
-      const bool convex =
-          one_object || blob_area >= options.single_object_solidity * cv::contourArea(hull);
+      const bool convex = one_object || blob_area >= options.single_object_solidity *
+                                                         ConvexHullArea(blob, blob_box);
       SeparationResult separated;
       if (convex) {
         std::vector<cv::Point> shifted = blob;
@@ -468,6 +630,21 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         separated = SeparateTouching(blob_mask, options.separation, options.separation_options);
       }
       const bool split = separated.pieces.size() > 1;
+      // Left whole: the one piece is the blob's own outline (convex, or nothing to cut).
+      const bool whole =
+          convex ||
+          (separated.pieces.size() == 1 &&
+           std::equal(
+               blob.begin(), blob.end(), separated.pieces[0].begin(), separated.pieces[0].end(),
+               [&](const cv::Point& b, const cv::Point& p) { return b == p + window.tl(); }));
+      // The blob's own outline (not cuts, not the image border): where arcs of objects show.
+      // Not needed for a blob left whole: every point of its piece is on the outline.
+      cv::Mat outline;
+      if (all_round && !whole) {
+        outline = cv::Mat(window.size(), CV_8UC1, cv::Scalar(0));
+        for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
+        cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
+      }
       for (std::vector<cv::Point> piece : separated.pieces) {
         ++st.pieces;
         for (cv::Point& p : piece) p += window.tl();
@@ -490,7 +667,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             const cv::Point local = p - window.tl();
             const bool on_border =
                 p.x <= 1 || p.y <= 1 || p.x >= bgr.cols - 2 || p.y >= bgr.rows - 2;
-            if (!on_border && outline.at<uint8_t>(local)) arc.push_back(p);
+            if (!on_border && (whole || outline.at<uint8_t>(local))) arc.push_back(p);
           }
           double inliers = 0.0;
           const std::optional<ArcFit> fit = FitArc(arc, &inliers);
@@ -524,12 +701,11 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           const cv::Rect roi = (d.box + cv::Size(2 * pad, 2 * pad) - cv::Point(pad, pad)) &
                                cv::Rect(0, 0, bgr.cols, bgr.rows);
           cv::Mat piece_mask;
-          if (convex && blob_mask_is_fill && roi == window) {
+          if (whole && blob_mask_is_fill && roi == window) {
             piece_mask = blob_mask;  // the same contour filled in the same window: no redraw
           } else {
             piece_mask = cv::Mat(roi.size(), CV_8UC1, cv::Scalar(0));
-            cv::drawContours(piece_mask, std::vector<std::vector<cv::Point>>{piece}, 0,
-                             cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0, -roi.tl());
+            FillOutline(piece, -roi.tl(), &piece_mask);
           }
           const cv::Mat depth_roi = depth_mm(roi);
           // The kind whose size fits best.

@@ -23,17 +23,44 @@ std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& b
 }
 
 uint16_t MedianReading(const std::vector<uint16_t>& readings) {
-  size_t rank = readings.size() / 2;
-  uint32_t high[256] = {};
-  for (const uint16_t r : readings) ++high[r >> 8];
-  unsigned h = 0;
-  while (rank >= high[h]) rank -= high[h++];
-  uint32_t low[256] = {};
-  for (const uint16_t r : readings) {
-    if ((r >> 8) == h) ++low[r & 0xff];
+  return MedianReading(readings.data(), readings.size());
+}
+
+uint16_t MedianReading(const uint16_t* r, size_t n) {
+  size_t rank = n / 2;
+  // Four interleaved counts: neighbouring readings of one surface share their high byte, and
+  // with a single table each increment would wait for the one before it.
+  uint32_t high[4][256] = {};
+  size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    ++high[0][r[i] >> 8];
+    ++high[1][r[i + 1] >> 8];
+    ++high[2][r[i + 2] >> 8];
+    ++high[3][r[i + 3] >> 8];
   }
+  for (; i < n; ++i) ++high[0][r[i] >> 8];
+  unsigned h = 0;
+  for (;; ++h) {
+    const size_t count = size_t{high[0][h]} + high[1][h] + high[2][h] + high[3][h];
+    if (rank < count) break;
+    rank -= count;
+  }
+  // Readings of another high byte go to a 257th bin, never read: no branch.
+  uint32_t low[4][257] = {};
+  const auto bin = [h](uint16_t reading) { return (reading >> 8) == h ? reading & 0xff : 256; };
+  for (i = 0; i + 4 <= n; i += 4) {
+    ++low[0][bin(r[i])];
+    ++low[1][bin(r[i + 1])];
+    ++low[2][bin(r[i + 2])];
+    ++low[3][bin(r[i + 3])];
+  }
+  for (; i < n; ++i) ++low[0][bin(r[i])];
   unsigned l = 0;
-  while (rank >= low[l]) rank -= low[l++];
+  for (;; ++l) {
+    const size_t count = size_t{low[0][l]} + low[1][l] + low[2][l] + low[3][l];
+    if (rank < count) break;
+    rank -= count;
+  }
   return static_cast<uint16_t>(h << 8 | l);
 }
 
@@ -54,19 +81,21 @@ std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv:
     if (cv::countNonZero(eroded) >= options.min_depth_pixels) inner = eroded;
   }
   const cv::Rect box = cv::boundingRect(inner);
-  std::vector<uint16_t> readings;
-  readings.reserve(box.area());
+  thread_local std::vector<uint16_t> readings;  // reused: no allocation per blob
+  if (readings.size() < static_cast<size_t>(box.area())) readings.resize(box.area());
+  size_t count = 0;
   for (int v = box.y; v < box.y + box.height; ++v) {
     const uint8_t* m = inner.ptr<uint8_t>(v);
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
     for (int u = box.x; u < box.x + box.width; ++u) {
-      if (m[u] && d[u]) readings.push_back(d[u]);
+      readings[count] = d[u];
+      count += (m[u] != 0) & (d[u] != 0);
     }
   }
-  if (static_cast<int>(readings.size()) < options.min_depth_pixels) return std::nullopt;
-  const double surface_m = camera.CorrectDepthM(MedianReading(readings));
+  if (static_cast<int>(count) < options.min_depth_pixels) return std::nullopt;
+  const double surface_m = camera.CorrectDepthM(MedianReading(readings.data(), count));
   if (!(surface_m > 0.0)) return std::nullopt;
-  return BlobSurface{surface_m, static_cast<int>(readings.size())};
+  return BlobSurface{surface_m, static_cast<int>(count)};
 }
 
 Measurement MeasureFromSurface(const BlobSurface& surface, const cv::Point2d& centre_px,

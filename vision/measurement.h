@@ -59,6 +59,7 @@ Measurement MeasureFromSurface(const BlobSurface& surface, const cv::Point2d& ce
 // The median of depth readings as std::nth_element gives it (the element of rank size / 2),
 // by a two-pass radix count instead of partial sorting. `readings` must not be empty.
 uint16_t MedianReading(const std::vector<uint16_t>& readings);
+uint16_t MedianReading(const uint16_t* readings, size_t count);  // count > 0
 
 // Range and bearing in the robot frame of a pixel with its (centre) depth.
 Eigen::Vector2d RangeBearing(const CameraModel& camera, double u, double v, double z_m);

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "platform/drive_base.h"
+#include "vision/contour_fill.h"
 
 namespace slamo::vision {
 namespace {
@@ -89,10 +90,43 @@ std::optional<cv::Point2d> MomentCentroid(const Contour& contour) {
   return cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
 }
 
+// The points of an outline that can lie on its convex hull, in the outline's order: those
+// that are the leftmost or rightmost of their row (or on the top or bottom row, a convex
+// outline's only horizontal edges) and the topmost or bottommost of their column (or on the
+// leftmost or rightmost column, its only vertical edges). The rest are inside the hull, and
+// cv::convexHull (which starts the hull where the input's order says) gives the same hull
+// for these as for the whole outline.
+const Contour& HullCandidates(const Contour& contour) {
+  thread_local Contour candidates;
+  thread_local std::vector<int> left, right, top, bottom;
+  const cv::Rect box = cv::boundingRect(contour);
+  left.assign(box.height, std::numeric_limits<int>::max());
+  right.assign(box.height, std::numeric_limits<int>::min());
+  top.assign(box.width, std::numeric_limits<int>::max());
+  bottom.assign(box.width, std::numeric_limits<int>::min());
+  for (const cv::Point& p : contour) {
+    const int row = p.y - box.y, column = p.x - box.x;
+    left[row] = std::min(left[row], p.x);
+    right[row] = std::max(right[row], p.x);
+    top[column] = std::min(top[column], p.y);
+    bottom[column] = std::max(bottom[column], p.y);
+  }
+  candidates.clear();
+  for (const cv::Point& p : contour) {
+    const int row = p.y - box.y, column = p.x - box.x;
+    const bool row_end = row == 0 || row == box.height - 1 || p.x == left[row] || p.x == right[row];
+    const bool column_end =
+        column == 0 || column == box.width - 1 || p.y == top[column] || p.y == bottom[column];
+    if (row_end && column_end) candidates.push_back(p);
+  }
+  return candidates;
+}
+
 // `centroid`: MomentCentroid(contour), when the caller has it already.
 BlobFrame FrameOf(const Contour& contour, const std::optional<cv::Point2d>& centroid) {
   BlobFrame frame;
-  const cv::RotatedRect rect = cv::minAreaRect(contour);
+  // The min-area rectangle is found on the convex hull: its candidate points are enough.
+  const cv::RotatedRect rect = cv::minAreaRect(HullCandidates(contour));
   cv::Point2f corners[4];
   rect.points(corners);
   const cv::Point2d side_a = corners[1] - corners[0], side_b = corners[2] - corners[1];
@@ -422,28 +456,33 @@ SeparationResult SeparateByDefects(const cv::Mat& binary, const SeparationOption
   // Holes are gaps enclosed by a ring of touching balls (or reflections inside one): fill
   // them so that cuts may cross them.
   cv::Mat work = cv::Mat::zeros(binary.size(), CV_8U);
-  const std::vector<Contour> blobs = ExternalContours(binary);
-  cv::drawContours(work, blobs, -1, cv::Scalar(255), cv::FILLED);
+  std::vector<Contour> blobs = ExternalContours(binary);
+  const size_t blob_count = blobs.size();
+  FillOutlines(blobs, cv::Point(), &work);
   // Each piece is measured against the (filled) blob it came from. One blob (a detector's
   // window) fills one 8-connected region: its area is the pixel count, no labelling needed.
   cv::Mat labels, stats, centroids;
   double single_blob_area = 0.0;
-  if (blobs.size() == 1) {
+  if (blob_count == 1) {
     single_blob_area = static_cast<double>(cv::countNonZero(work));
   } else {
     cv::connectedComponentsWithStats(work, labels, stats, centroids, 8, CV_32S);
   }
   auto blob_area = [&](const Contour& piece) {
-    if (blobs.size() == 1) return single_blob_area;
+    if (blob_count == 1) return single_blob_area;
     return static_cast<double>(stats.at<int>(labels.at<int>(piece.front()), cv::CC_STAT_AREA));
   };
   // The outlines of `work` as it is now: after a pass that cuts nothing they are the final ones.
+  // Filling changed nothing (no holes, the usual case): they are the blobs' own outlines.
   std::vector<Contour> contours;
   bool contours_current = false;
+  const bool filled_is_binary = binary.isContinuous() && work.isContinuous() &&
+                                std::equal(binary.datastart, binary.dataend, work.datastart);
+  if (filled_is_binary) contours = std::move(blobs), contours_current = true;
   for (int pass = 0; pass < options.max_passes; ++pass) {
     // Find every blob's cut first, then draw them: one cut per blob per pass.
     std::vector<Cut> cuts;
-    contours = ExternalContours(work);
+    if (!contours_current) contours = ExternalContours(work);
     contours_current = true;
     for (const Contour& contour : contours) {
       const double min_piece_area_px = options.min_piece_area_ratio * blob_area(contour);

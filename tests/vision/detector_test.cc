@@ -298,6 +298,39 @@ TEST(ColourClassesTest, RedHueWrapsAroundZero) {
   EXPECT_THROW(MakeColourClass("grey", field::Rgb{128, 128, 128}), std::invalid_argument);
 }
 
+// The one-pass threshold of several classes gives each class's ThresholdHsv mask, wrapping
+// and fractional windows too. Both are windows on each channel separately, so every hue
+// against every saturation (value 255) and every hue against every value (saturation 255)
+// covers every window edge; hue runs past 180.
+TEST(ColourClassesTest, OnePassThresholdMatchesEachClass) {
+  std::vector<ColourClass> colours;
+  for (const char* name : {"toss_up", "high_stakes", "over_under", "starstruck", "skyrise"}) {
+    const field::SeasonConfig season = field::LoadSeasonConfig(name);
+    for (const ColourClass& c : ObjectColourClasses(season)) colours.push_back(c);
+    for (const ColourClass& c : LandmarkColourClasses(season)) colours.push_back(c);
+  }
+  ColourClass odd = MakeColourClass("odd", field::Rgb{250, 10, 120});
+  odd.hue_deg = 359.3, odd.hue_tolerance_deg = 0.7, odd.min_saturation = 0, odd.min_value = 255;
+  colours.push_back(odd);
+  odd.hue_deg = 0.25, odd.hue_tolerance_deg = 1.25, odd.min_saturation = 255, odd.min_value = 0;
+  colours.push_back(odd);
+  odd.hue_deg = 181.0, odd.hue_tolerance_deg = 89.0, odd.min_saturation = 17, odd.min_value = 3;
+  colours.push_back(odd);
+  cv::Mat hsv(512, 263, CV_8UC3, cv::Scalar(0, 0, 0));  // 263: a row end past 16-pixel blocks
+  for (int v = 0; v < 256; ++v) {
+    for (int u = 0; u < 256; ++u) {
+      hsv.at<cv::Vec3b>(v, (u + v) % 263) = cv::Vec3b(v, u, 255);
+      hsv.at<cv::Vec3b>(256 + v, (u + v) % 263) = cv::Vec3b(v, 255, u);
+    }
+  }
+  const std::vector<cv::Mat> masks = ThresholdHsv(hsv, colours);
+  ASSERT_EQ(masks.size(), colours.size());
+  for (size_t j = 0; j < colours.size(); ++j) {
+    SCOPED_TRACE(colours[j].name);
+    EXPECT_EQ(cv::norm(masks[j], ThresholdHsv(hsv, colours[j]), cv::NORM_INF), 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace slamo::vision
 

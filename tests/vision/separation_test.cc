@@ -12,6 +12,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/contour_fill.h"
+
 namespace slamo::vision {
 namespace {
 
@@ -419,6 +421,44 @@ TEST(SeparationTest, ParseSeparationMethod) {
     ParseSeparationMethod("blobs");
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("defects, watershed, none"), std::string::npos);
+  }
+}
+
+// FillOutline(s) fill exactly what cv::drawContours(FILLED, LINE_8) does: traced outlines of
+// random blobs (holes too, several at once, shifted), and simplified ones (its own fallback).
+TEST(ContourFillTest, SameAsDrawContours) {
+  std::mt19937 rng(17);
+  for (int trial = 0; trial < 250; ++trial) {
+    const int w = 2 + static_cast<int>(rng() % 120), h = 2 + static_cast<int>(rng() % 120);
+    cv::Mat mask = cv::Mat::zeros(h, w, CV_8UC1);
+    for (int s = 0; s < 4; ++s) {
+      const cv::Point c(static_cast<int>(rng() % w), static_cast<int>(rng() % h));
+      cv::ellipse(mask, c, cv::Size(1 + rng() % 40, 1 + rng() % 25), rng() % 180, 0, 360,
+                  cv::Scalar(255), cv::FILLED);
+    }
+    cv::Mat noise(h, w, CV_8UC1);
+    cv::randu(noise, 0, 255);
+    mask.setTo(0, noise < 40);
+    std::vector<std::vector<cv::Point>> outlines;
+    cv::findContours(mask, outlines, trial % 2 ? cv::RETR_EXTERNAL : cv::RETR_LIST,
+                     cv::CHAIN_APPROX_NONE);
+    if (trial % 5 == 0 && !outlines.empty()) {
+      cv::approxPolyDP(std::vector<cv::Point>(outlines[0]), outlines[0], 1.0, true);
+    }
+    const cv::Point offset(static_cast<int>(rng() % 4), static_cast<int>(rng() % 4));
+    const cv::Size size(w + 4, h + 4);
+    for (const std::vector<cv::Point>& outline : outlines) {
+      cv::Mat expected = cv::Mat::zeros(size, CV_8UC1), filled = cv::Mat::zeros(size, CV_8UC1);
+      cv::drawContours(expected, std::vector<std::vector<cv::Point>>{outline}, 0, cv::Scalar(255),
+                       cv::FILLED, cv::LINE_8, cv::noArray(), 0, offset);
+      FillOutline(outline, offset, &filled);
+      ASSERT_EQ(cv::norm(expected, filled, cv::NORM_INF), 0.0) << "trial " << trial;
+    }
+    cv::Mat expected = cv::Mat::zeros(size, CV_8UC1), filled = cv::Mat::zeros(size, CV_8UC1);
+    cv::drawContours(expected, outlines, -1, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(),
+                     INT_MAX, offset);
+    FillOutlines(outlines, offset, &filled);
+    ASSERT_EQ(cv::norm(expected, filled, cv::NORM_INF), 0.0) << "trial " << trial;
   }
 }
 
