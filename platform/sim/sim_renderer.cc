@@ -43,21 +43,107 @@ namespace {
 using Primitive = SimRenderer::Primitive;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// Buffers hold this many pixels beyond the image, for the passes' four-pixel groups.
+constexpr size_t kPad = 4;
 
 Vector3d Albedo(const field::SeasonConfig& season, const std::string& colour) {
   const field::Rgb& c = season.colours.at(colour);
   return Vector3d(c.r, c.g, c.b) / 255.0;
 }
 
+// Four floats in SSE2 registers with the operators of float: each lane rounds exactly as the
+// scalar code does (SSE2 has no FMA and nothing here reassociates), so four pixels shaded at
+// once get the bits one pixel at a time got. Eigen's fixed-size 3-vector reductions add as
+// x + (y + z); Dot and Normalized below do the same.
+struct F4 {
+  __m128 m;
+  F4() = default;
+  explicit F4(__m128 v) : m(v) {}
+  F4(float x) : m(_mm_set1_ps(x)) {}  // NOLINT: constants as in the scalar expressions
+};
+inline F4 operator+(F4 a, F4 b) { return F4(_mm_add_ps(a.m, b.m)); }
+inline F4 operator-(F4 a, F4 b) { return F4(_mm_sub_ps(a.m, b.m)); }
+inline F4 operator*(F4 a, F4 b) { return F4(_mm_mul_ps(a.m, b.m)); }
+inline F4 operator/(F4 a, F4 b) { return F4(_mm_div_ps(a.m, b.m)); }
+inline F4 operator-(F4 a) { return F4(_mm_xor_ps(a.m, _mm_set1_ps(-0.0f))); }
+inline F4 Sqrt(F4 a) { return F4(_mm_sqrt_ps(a.m)); }
+inline F4 MaxZero(F4 a) { return F4(_mm_max_ps(a.m, _mm_setzero_ps())); }  // std::max(0.0f, a)
+inline F4 MinOne(F4 a) { return F4(_mm_min_ps(a.m, _mm_set1_ps(1.0f))); }  // std::min(1.0f, a)
+inline F4 Load4(const float* p) { return F4(_mm_loadu_ps(p)); }
+
+struct M4 {  // a lane mask: all ones or all zeros
+  __m128 m;
+};
+inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.m, b.m)}; }
+inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.m, b.m)}; }
+inline M4 operator<=(F4 a, F4 b) { return {_mm_cmple_ps(a.m, b.m)}; }
+inline M4 operator>=(F4 a, F4 b) { return {_mm_cmpge_ps(a.m, b.m)}; }
+inline M4 operator==(F4 a, F4 b) { return {_mm_cmpeq_ps(a.m, b.m)}; }
+// The negated comparisons, true for NaN as `if (a < b) continue;` lets NaN through.
+inline M4 NotLess(F4 a, F4 b) { return {_mm_cmpnlt_ps(a.m, b.m)}; }
+inline M4 NotLessEqual(F4 a, F4 b) { return {_mm_cmpnle_ps(a.m, b.m)}; }
+inline M4 NotGreaterEqual(F4 a, F4 b) { return {_mm_cmpnge_ps(a.m, b.m)}; }
+inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.m, b.m)}; }
+inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.m, b.m)}; }
+inline M4 AndNot(M4 a, M4 b) { return {_mm_andnot_ps(b.m, a.m)}; }  // a & ~b
+inline int Bits(M4 a) { return _mm_movemask_ps(a.m); }
+inline F4 Select(M4 mask, F4 a, F4 b) {
+  return F4(_mm_or_ps(_mm_and_ps(mask.m, a.m), _mm_andnot_ps(mask.m, b.m)));
+}
+inline M4 Select(M4 mask, M4 a, M4 b) { return {Select(mask, F4(a.m), F4(b.m)).m}; }
+
+struct V3 {
+  F4 x, y, z;
+};
+inline F4 Dot(const V3& a, const V3& b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
+// Eigen's normalized(): v / |v|, or v itself when |v|^2 is not positive.
+inline V3 Normalized(const V3& v) {
+  const F4 n2 = Dot(v, v);
+  const F4 n = Sqrt(n2);
+  const M4 positive = n2 > F4(0.0f);
+  return {Select(positive, v.x / n, v.x), Select(positive, v.y / n, v.y),
+          Select(positive, v.z / n, v.z)};
+}
 // x^n by squaring (n >= 0): the highlight exponents, without std::pow per pixel.
-float PowInt(float x, int n) {
-  float result = 1.0f;
+inline F4 PowInt4(F4 x, int n) {
+  F4 result(1.0f);
   while (n > 0) {
-    if (n & 1) result *= x;
-    x *= x;
+    if (n & 1) result = result * x;
+    x = x * x;
     n >>= 1;
   }
   return result;
+}
+
+// Four consecutive RGB pixels (12 floats) to and from one register per channel.
+inline void LoadRgb4(const Vector3f* p, F4* r, F4* g, F4* b) {
+  const float* f = p->data();
+  const __m128 a = _mm_loadu_ps(f), c = _mm_loadu_ps(f + 4), e = _mm_loadu_ps(f + 8);
+  // a = r0 g0 b0 r1, c = g1 b1 r2 g2, e = b2 r3 g3 b3
+  const __m128 ce_r = _mm_shuffle_ps(c, e, _MM_SHUFFLE(1, 1, 2, 2));  // r2 r2 r3 r3
+  const __m128 ac_g = _mm_shuffle_ps(a, c, _MM_SHUFFLE(0, 0, 1, 1));  // g0 g0 g1 g1
+  const __m128 ce_g = _mm_shuffle_ps(c, e, _MM_SHUFFLE(2, 2, 3, 3));  // g2 g2 g3 g3
+  const __m128 ac_b = _mm_shuffle_ps(a, c, _MM_SHUFFLE(1, 1, 2, 2));  // b0 b0 b1 b1
+  const __m128 ee_b = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 3, 0, 0));  // b2 b2 b3 b3
+  r->m = _mm_shuffle_ps(a, ce_r, _MM_SHUFFLE(2, 0, 3, 0));
+  g->m = _mm_shuffle_ps(ac_g, ce_g, _MM_SHUFFLE(2, 0, 2, 0));
+  b->m = _mm_shuffle_ps(ac_b, ee_b, _MM_SHUFFLE(2, 0, 2, 0));
+}
+inline void StoreRgb4(Vector3f* p, F4 r, F4 g, F4 b) {
+  float* f = p->data();
+  const __m128 rg_lo = _mm_unpacklo_ps(r.m, g.m);  // r0 g0 r1 g1
+  const __m128 rg_hi = _mm_unpackhi_ps(r.m, g.m);  // r2 g2 r3 g3
+  // r0 g0 b0 r1
+  const __m128 b0r1 = _mm_shuffle_ps(b.m, r.m, _MM_SHUFFLE(1, 1, 0, 0));  // b0 b0 r1 r1
+  const __m128 a = _mm_shuffle_ps(rg_lo, b0r1, _MM_SHUFFLE(2, 0, 1, 0));
+  // g1 b1 r2 g2
+  const __m128 g1b1 = _mm_shuffle_ps(g.m, b.m, _MM_SHUFFLE(1, 1, 1, 1));  // g1 g1 b1 b1
+  const __m128 c = _mm_shuffle_ps(g1b1, rg_hi, _MM_SHUFFLE(1, 0, 2, 0));
+  // b2 r3 g3 b3
+  const __m128 b2r3 = _mm_shuffle_ps(b.m, r.m, _MM_SHUFFLE(3, 3, 2, 2));  // b2 b2 r3 r3
+  const __m128 g3b3 = _mm_shuffle_ps(g.m, b.m, _MM_SHUFFLE(3, 3, 3, 3));  // g3 g3 b3 b3
+  const __m128 e = _mm_shuffle_ps(b2r3, g3b3, _MM_SHUFFLE(2, 0, 2, 0));
+  _mm_storeu_ps(f, a), _mm_storeu_ps(f + 4, c), _mm_storeu_ps(f + 8, e);
 }
 
 double Luminance(const Vector3d& rgb) {
@@ -361,9 +447,11 @@ struct SimRenderer::Buffers {
     width = w, height = h;
     const size_t n = static_cast<size_t>(w) * h;
     // Kept between frames: resizing is a no-op after the first, so no fresh pages per frame.
-    t.resize(n), colour.resize(n), id.resize(n), no_depth.resize(n), row_rays.resize(h);
+    // Three pixels more than the image: the passes work on four pixels at a time.
+    t.resize(n + kPad), colour.resize(n + kPad), id.resize(n + kPad), no_depth.resize(n + kPad);
+    row_rays.resize(h);
     // t, colour and no_depth are written for every pixel by the floor pass.
-    std::fill(id.begin(), id.end(), uint16_t{0});
+    std::fill(id.begin(), id.begin() + n, uint16_t{0});
   }
 };
 
@@ -385,6 +473,7 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
       ray_length2_.push_back(rays_cam_.back().squaredNorm());
     }
   }
+  ray_length2_.resize(ray_length2_.size() + kPad, 1.0f);  // read four pixels at a time
   // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
   // without a normal draw per pixel per frame. The pool holds four frames' worth of pixels
   // (at least 2^20), so a frame's colour noise (3 per pixel) always fits after an offset.
@@ -658,104 +747,162 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     if (iu1 < iu0 || iv1 < iv0) return cv::Rect();
     return cv::Rect(iu0, iv0, iu1 - iu0 + 1, iv1 - iv0 + 1);
   };
-  // Calls on_hit(pixel, ray, t, normal) for each pixel where `p` is the nearest surface so far.
+  // Calls on_hit(first pixel, lanes, rays, t, normals) for four pixels of a row at a time, the
+  // lanes set where `p` is the nearest surface so far. The buffers hold three pixels beyond
+  // the last, so a row's last group may read and write past its end (its lanes stay clear).
+  const F4 lane_offsets(_mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f));
+  const F4 step_x(ray_step.x()), step_y(ray_step.y()), step_z(ray_step.z());
   const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) {
     const cv::Rect box = screen_box(p);
+    const int u_end = box.x + box.width;
+    const auto for_each_group = [&](auto&& group) {
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        const F4 row_x(row_rays[v].x()), row_y(row_rays[v].y()), row_z(row_rays[v].z());
+        for (int u0 = box.x; u0 < u_end; u0 += 4) {
+          const F4 u = F4(static_cast<float>(u0)) + lane_offsets;  // exact: small integers
+          // The ray as one pixel at a time: start of row plus u steps.
+          const V3 d{row_x + u * step_x, row_y + u * step_y, row_z + u * step_z};
+          group(static_cast<size_t>(v) * w + u0, u < F4(static_cast<float>(u_end)), d);
+        }
+      }
+    };
     if (p.kind == PrimitiveKind::kSphere) {
       // Spheres, the most common object, in single precision: |d|^2 is the camera ray's
       // (rotation keeps lengths), so a hit costs a dot product and a square root.
-      const Vector3f oc = (origin - p.center).cast<float>();
-      const float c = oc.squaredNorm() - static_cast<float>(p.radius * p.radius);
-      const float inv_r = static_cast<float>(1.0 / p.radius);
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          const size_t i = static_cast<size_t>(v) * w + u;
-          const Vector3f d = row_rays[v] + static_cast<float>(u) * ray_step;
-          const float b = oc.dot(d);
-          const float a = ray_length2_[i];
-          const float disc = b * b - a * c;
-          if (disc < 0.0f) continue;
-          const float t = (-b - std::sqrt(disc)) / a;
-          if (t <= 1e-6f || t >= out->t[i]) continue;
-          on_hit(i, d, t, Vector3f((oc + t * d) * inv_r));
-        }
-      }
+      const Vector3f oc_f = (origin - p.center).cast<float>();
+      const V3 oc{oc_f.x(), oc_f.y(), oc_f.z()};
+      const F4 c = oc_f.squaredNorm() - static_cast<float>(p.radius * p.radius);
+      const F4 inv_r = static_cast<float>(1.0 / p.radius);
+      for_each_group([&](size_t i, M4 lanes, const V3& d) {
+        const F4 b = Dot(oc, d);
+        const F4 a = Load4(&ray_length2_[i]);
+        const F4 disc = b * b - a * c;
+        const F4 t = (-b - Sqrt(disc)) / a;
+        const M4 hit = lanes & NotLess(disc, 0.0f) & NotLessEqual(t, 1e-6f) &
+                       NotGreaterEqual(t, Load4(&out->t[i]));
+        if (!Bits(hit)) return;
+        on_hit(i, hit, d, t,
+               V3{(oc.x + t * d.x) * inv_r, (oc.y + t * d.y) * inv_r, (oc.z + t * d.z) * inv_r});
+      });
       return;
     }
     if (p.kind == PrimitiveKind::kBox) {
       // Boxes (structures, cubes, opponents) in single precision, in the box's own frame.
-      const float cy = static_cast<float>(p.cos_yaw), sy = static_cast<float>(p.sin_yaw);
+      const F4 cy = static_cast<float>(p.cos_yaw), sy = static_cast<float>(p.sin_yaw);
+      const F4 neg_sy = -static_cast<float>(p.sin_yaw);
       const float rx = static_cast<float>(origin.x() - p.center.x());
       const float ry = static_cast<float>(origin.y() - p.center.y());
-      const float lo_o[3] = {cy * rx + sy * ry, -sy * rx + cy * ry, static_cast<float>(origin.z())};
-      const float lo_b[3] = {static_cast<float>(-p.half_x), static_cast<float>(-p.half_y),
-                             static_cast<float>(p.z0)};
-      const float hi_b[3] = {static_cast<float>(p.half_x), static_cast<float>(p.half_y),
-                             static_cast<float>(p.z1)};
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          const size_t i = static_cast<size_t>(v) * w + u;
-          const Vector3f d = row_rays[v] + static_cast<float>(u) * ray_step;
-          const float ld[3] = {cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y(), d.z()};
-          float t_near = -kInf, t_far = kInf;
-          int axis = -1;
-          float sign = 1.0f;
-          bool miss = false;
-          for (int k = 0; k < 3 && !miss; ++k) {
-            if (std::abs(ld[k]) < 1e-12f) {
-              miss = lo_o[k] < lo_b[k] || lo_o[k] > hi_b[k];
-              continue;
-            }
-            const float inv = 1.0f / ld[k];
-            float t0 = (lo_b[k] - lo_o[k]) * inv, t1 = (hi_b[k] - lo_o[k]) * inv;
-            float sg = -1.0f;
-            if (t0 > t1) std::swap(t0, t1), sg = 1.0f;
-            if (t0 > t_near) t_near = t0, axis = k, sign = sg;
-            t_far = std::min(t_far, t1);
-            miss = t_near > t_far;
-          }
-          if (miss || axis < 0 || t_near <= 1e-6f || t_near >= out->t[i]) continue;
-          Vector3f n = Vector3f::Zero();
-          if (axis == 2) {
-            n.z() = sign;
-          } else {
-            const float lx = axis == 0 ? sign : 0.0f, ly = axis == 1 ? sign : 0.0f;
-            n = Vector3f(cy * lx - sy * ly, sy * lx + cy * ly, 0.0f);
-          }
-          on_hit(i, d, t_near, n);
+      const float cy_f = static_cast<float>(p.cos_yaw), sy_f = static_cast<float>(p.sin_yaw);
+      const F4 lo_o[3] = {cy_f * rx + sy_f * ry, -sy_f * rx + cy_f * ry,
+                          static_cast<float>(origin.z())};
+      const F4 lo_b[3] = {static_cast<float>(-p.half_x), static_cast<float>(-p.half_y),
+                          static_cast<float>(p.z0)};
+      const F4 hi_b[3] = {static_cast<float>(p.half_x), static_cast<float>(p.half_y),
+                          static_cast<float>(p.z1)};
+      const F4 zero(0.0f), one(1.0f), minus_one(-1.0f);
+      for_each_group([&](size_t i, M4 lanes, const V3& d) {
+        const F4 ld[3] = {cy * d.x + sy * d.y, neg_sy * d.x + cy * d.y, d.z};
+        F4 t_near = -kInf, t_far = kInf;
+        // The slab test per axis; a lane that misses on one axis stops there, one pixel at a
+        // time, so its miss is kept whatever the later axes say.
+        M4 miss{_mm_setzero_ps()}, has_axis{_mm_setzero_ps()};
+        F4 lx = zero, ly = zero, lz = zero;  // the entry face's local normal
+        for (int k = 0; k < 3; ++k) {
+          const M4 parallel = F4(_mm_andnot_ps(_mm_set1_ps(-0.0f), ld[k].m)) < F4(1e-12f);
+          const M4 outside = (lo_o[k] < lo_b[k]) | (lo_o[k] > hi_b[k]);
+          const F4 inv = one / ld[k];
+          const F4 t0 = (lo_b[k] - lo_o[k]) * inv, t1 = (hi_b[k] - lo_o[k]) * inv;
+          const M4 swap = t0 > t1;
+          const F4 near_k = Select(swap, t1, t0), far_k = Select(swap, t0, t1);
+          const F4 sign = Select(swap, one, minus_one);
+          const M4 enter = AndNot(near_k > t_near, parallel);
+          t_near = Select(enter, near_k, t_near);
+          lx = Select(enter, k == 0 ? sign : zero, lx);
+          ly = Select(enter, k == 1 ? sign : zero, ly);
+          lz = Select(enter, k == 2 ? sign : zero, lz);
+          has_axis = has_axis | enter;
+          t_far = Select(parallel, t_far, F4(_mm_min_ps(far_k.m, t_far.m)));  // std::min
+          miss = miss | Select(parallel, outside, t_near > t_far);
         }
-      }
+        const M4 hit = AndNot(lanes & has_axis, miss) & NotLessEqual(t_near, 1e-6f) &
+                       NotGreaterEqual(t_near, Load4(&out->t[i]));
+        if (!Bits(hit)) return;
+        // On a side face the normal is turned back by the yaw; on top or bottom it is +-z.
+        const M4 side = lz == zero;
+        on_hit(
+            i, hit, d, t_near,
+            V3{Select(side, cy * lx - sy * ly, zero), Select(side, sy * lx + cy * ly, zero), lz});
+      });
       return;
     }
-    for (int v = box.y; v < box.y + box.height; ++v) {
-      for (int u = box.x; u < box.x + box.width; ++u) {
-        const size_t i = static_cast<size_t>(v) * w + u;
-        const Vector3d d = (row_rays[v] + static_cast<float>(u) * ray_step).cast<double>();
+    // Everything else in double precision, one pixel at a time, shaded four at a time.
+    for_each_group([&](size_t i, M4 lanes, const V3& d) {
+      alignas(16) float dx[4], dy[4], dz[4], t_lane[4], nx[4], ny[4], nz[4];
+      _mm_store_ps(dx, d.x.m), _mm_store_ps(dy, d.y.m), _mm_store_ps(dz, d.z.m);
+      const int valid = Bits(lanes);
+      alignas(16) int32_t hit_lane[4] = {0, 0, 0, 0};
+      for (int k = 0; k < 4; ++k) {
+        t_lane[k] = 0.0f, nx[k] = ny[k] = nz[k] = 0.0f;
+        if (!(valid >> k & 1)) continue;
+        const Vector3d dd = Vector3f(dx[k], dy[k], dz[k]).cast<double>();
         double t = 0.0;
         Vector3d n = Vector3d::Zero();
-        if (Intersect(p, origin, d, &t, &n) && t < out->t[i]) {
-          on_hit(i, d.cast<float>(), static_cast<float>(t), n.cast<float>());
+        if (Intersect(p, origin, dd, &t, &n) && t < out->t[i + k]) {
+          hit_lane[k] = -1;
+          t_lane[k] = static_cast<float>(t);
+          nx[k] = static_cast<float>(n.x()), ny[k] = static_cast<float>(n.y());
+          nz[k] = static_cast<float>(n.z());
         }
       }
+      const M4 hit{_mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(hit_lane)))};
+      if (!Bits(hit)) return;
+      on_hit(i, hit, d, F4(_mm_load_ps(t_lane)),
+             V3{F4(_mm_load_ps(nx)), F4(_mm_load_ps(ny)), F4(_mm_load_ps(nz))});
+    });
+  };
+  // Writes the hit lanes of four pixels: depth, id, colour and the no-depth flag.
+  const auto store = [&](size_t i, M4 hit, F4 t, int id, const V3& c, M4 no_depth) {
+    _mm_storeu_ps(&out->t[i], Select(hit, t, Load4(&out->t[i])).m);
+    const __m128i hit16 = _mm_packs_epi32(_mm_castps_si128(hit.m), _mm_castps_si128(hit.m));
+    __m128i* id_at = reinterpret_cast<__m128i*>(&out->id[i]);
+    const __m128i ids = _mm_set1_epi16(static_cast<int16_t>(static_cast<uint16_t>(id)));
+    _mm_storel_epi64(id_at, _mm_or_si128(_mm_and_si128(hit16, ids),
+                                         _mm_andnot_si128(hit16, _mm_loadl_epi64(id_at))));
+    F4 r, g, b;
+    LoadRgb4(&out->colour[i], &r, &g, &b);
+    StoreRgb4(&out->colour[i], Select(hit, c.x, r), Select(hit, c.y, g), Select(hit, c.z, b));
+    const int hits = Bits(hit), flags = Bits(no_depth);
+    for (int k = 0; k < 4; ++k) {
+      if (hits >> k & 1) out->no_depth[i + k] = flags >> k & 1;
     }
   };
+  const V3 to_light{to_light_f.x(), to_light_f.y(), to_light_f.z()};
+  const F4 ambient4(ambient_f), diffuse4(diffuse_f);
+  // shade_f for four normals: albedo * tint * (ambient + diffuse * max(0, n . l)).
+  const auto shade4 = [&](const Vector3f& albedo_tint, const V3& n) {
+    const F4 lambert = ambient4 + diffuse4 * MaxZero(Dot(n, to_light));
+    return V3{F4(albedo_tint.x()) * lambert, F4(albedo_tint.y()) * lambert,
+              F4(albedo_tint.z()) * lambert};
+  };
   for (const Primitive& p : primitives) {
-    const Vector3f albedo = p.albedo.cast<float>();
-    const uint8_t black = Luminance(p.albedo) < options_.black_albedo ? 1 : 0;
-    for_each_hit(p, [&](size_t i, const Vector3f& d, float t, const Vector3f& n) {
-      out->t[i] = t;
-      out->id[i] = static_cast<uint16_t>(p.id);
-      Vector3f c = shade_f(albedo, n);
+    const Vector3f albedo_tint = p.albedo.cast<float>().cwiseProduct(tint_f);
+    const M4 black{
+        _mm_castsi128_ps(_mm_set1_epi32(Luminance(p.albedo) < options_.black_albedo ? -1 : 0))};
+    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) {
+      V3 c = shade4(albedo_tint, n);
       if (p.glossy) {
         // Facing away from the half vector (n . h <= 0 before normalising), n . h / |h| is at
         // most a few 1e-7 and its 40th power is 0 in float: no highlight, as computed in full.
-        const Vector3f h = to_light_f - d.normalized();
-        if (n.dot(h) > 0.0f) {
-          c += Vector3f::Constant(0.25f * PowInt(std::max(0.0f, n.dot(h.normalized())), 40));
+        const V3 dn = Normalized(d);
+        const V3 h{to_light.x - dn.x, to_light.y - dn.y, to_light.z - dn.z};
+        const M4 facing = Dot(n, h) > F4(0.0f);
+        if (Bits(facing & hit)) {
+          const F4 highlight = F4(0.25f) * PowInt4(MaxZero(Dot(n, Normalized(h))), 40);
+          c = V3{Select(facing, c.x + highlight, c.x), Select(facing, c.y + highlight, c.y),
+                 Select(facing, c.z + highlight, c.z)};
         }
       }
-      out->colour[i] = c;
-      out->no_depth[i] = black;
+      store(i, hit, t, p.id, c, black);
     });
   }
 
@@ -764,40 +911,59 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     return (a.center - origin).squaredNorm() > (b.center - origin).squaredNorm();
   });
 
+  // spec > specular_dropout (a double) in float: above the largest float not above it.
+  float dropout = static_cast<float>(options_.specular_dropout);
+  if (static_cast<double>(dropout) > options_.specular_dropout) {
+    dropout = std::nextafter(dropout, -kInf);
+  }
+  const F4 dropout4(dropout);
   for (const Primitive& p : transparent) {
     const Vector3f tint = p.albedo.cast<float>();
-    const float opacity = static_cast<float>(p.opacity);
-    const Vector3f albedo = p.albedo.cast<float>();
-    for_each_hit(p, [&](size_t i, const Vector3f& d, float t, const Vector3f& n) {
-      const Vector3f view = -d.normalized();
+    const F4 opacity = static_cast<float>(p.opacity);
+    const F4 clear = 1.0f - static_cast<float>(p.opacity);
+    const Vector3f albedo_tint = p.albedo.cast<float>().cwiseProduct(tint_f);
+    const Vector3f filter = Vector3f::Constant(0.35f) + 0.65f * tint;
+    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) {
+      const V3 dn = Normalized(d);
+      const V3 view{-dn.x, -dn.y, -dn.z};
       // Thin tinted plastic: the background shows through, filtered by the tint.
-      const Vector3f behind = out->colour[i].cwiseProduct(Vector3f::Constant(0.35f) + 0.65f * tint);
-      Vector3f c = opacity * shade_f(albedo, n) + (1.0f - opacity) * behind;
+      V3 behind;
+      LoadRgb4(&out->colour[i], &behind.x, &behind.y, &behind.z);
+      const V3 shaded = shade4(albedo_tint, n);
+      V3 c{opacity * shaded.x + clear * (behind.x * F4(filter.x())),
+           opacity * shaded.y + clear * (behind.y * F4(filter.y())),
+           opacity * shaded.z + clear * (behind.z * F4(filter.z()))};
       // Reflections: the ceiling lights as bright low-saturation patches, stronger at
       // grazing angles (Fresnel), plus the light's specular highlight.
-      const float n_dot_view = n.dot(view);
-      const Vector3f reflected = 2.0f * n_dot_view * n - view;
-      const float grazing = 1.0f - std::max(0.0f, n_dot_view);
-      const float fresnel = 0.1f + 0.9f * (grazing * grazing) * (grazing * grazing);
-      // Six ceiling light bands around the azimuth: sin(6 phi) from (x + iy)^6, no trig.
-      float ceiling = std::clamp((reflected.z() - 0.45f) / 0.25f, 0.0f, 1.0f);
-      if (ceiling > 0.0f) {
-        const float r2 = reflected.x() * reflected.x() + reflected.y() * reflected.y();
-        const std::complex<float> c1(reflected.x(), reflected.y());
-        const std::complex<float> c2 = c1 * c1;
-        ceiling *= 0.5f + 0.5f * (c2 * c2 * c2).imag() / (r2 * r2 * r2);
+      const F4 n_dot_view = Dot(n, view);
+      const F4 twice = F4(2.0f) * n_dot_view;
+      const V3 reflected{twice * n.x - view.x, twice * n.y - view.y, twice * n.z - view.z};
+      const F4 grazing = F4(1.0f) - MaxZero(n_dot_view);
+      const F4 fresnel = F4(0.1f) + F4(0.9f) * (grazing * grazing) * (grazing * grazing);
+      // Six ceiling light bands around the azimuth: sin(6 phi) from (x + iy)^6, no trig (the
+      // products std::complex<float> takes: re = ac - bd, im = ad + bc).
+      const F4 q = (reflected.z - 0.45f) / 0.25f;
+      F4 ceiling = Select(q < F4(0.0f), 0.0f, Select(F4(1.0f) < q, 1.0f, q));  // std::clamp
+      const M4 lit = ceiling > F4(0.0f);
+      if (Bits(lit & hit)) {
+        const F4 rx = reflected.x, ry = reflected.y;
+        const F4 r2 = rx * rx + ry * ry;
+        const F4 c2_re = rx * rx - ry * ry, c2_im = rx * ry + ry * rx;
+        const F4 c4_re = c2_re * c2_re - c2_im * c2_im, c4_im = c2_re * c2_im + c2_im * c2_re;
+        const F4 c6_im = c4_re * c2_im + c4_im * c2_re;
+        ceiling = Select(lit, ceiling * (F4(0.5f) + F4(0.5f) * c6_im / (r2 * r2 * r2)), ceiling);
       }
-      const float patch = std::min(1.0f, fresnel * 0.6f + 0.7f * ceiling);
+      const F4 patch = MinOne(fresnel * 0.6f + F4(0.7f) * ceiling);
       // As for glossy solids: n . h <= 0 before normalising means a highlight of exactly 0.
-      const Vector3f h = view + to_light_f;
-      const float spec =
-          n.dot(h) > 0.0f ? 0.9f * PowInt(std::max(0.0f, n.dot(h.normalized())), 60) : 0.0f;
-      c = (1.0f - patch) * c + patch * Vector3f::Constant(0.85f);
-      c += Vector3f::Constant(spec);
-      out->colour[i] = c;
-      out->t[i] = t;
-      out->id[i] = static_cast<uint16_t>(p.id);
-      out->no_depth[i] = spec > options_.specular_dropout ? 1 : 0;
+      const V3 h{view.x + to_light.x, view.y + to_light.y, view.z + to_light.z};
+      const M4 facing = Dot(n, h) > F4(0.0f);
+      F4 spec = 0.0f;
+      if (Bits(facing & hit)) {
+        spec = Select(facing, F4(0.9f) * PowInt4(MaxZero(Dot(n, Normalized(h))), 60), 0.0f);
+      }
+      const F4 keep = F4(1.0f) - patch, glare = patch * F4(0.85f);
+      c = V3{keep * c.x + glare + spec, keep * c.y + glare + spec, keep * c.z + glare + spec};
+      store(i, hit, t, p.id, c, spec > dropout4);
     });
   }
 }
