@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <limits>
 
 #include <emmintrin.h>
@@ -593,91 +594,122 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   const bool floor_black = Luminance(tile_albedo) < options_.black_albedo;
   const bool wall_black = Luminance(wall_albedo) < options_.black_albedo;
   constexpr float kSeamM = 0.004f;
-  // Each tile's shade factor by its hash's low byte: the same float as computed per pixel,
-  // without a division per floor pixel.
-  float tile_variation[256];
-  for (int k = 0; k < 256; ++k) tile_variation[k] = 0.96f + 0.08f * (k / 255.0f);
   // The world ray is linear in u along a row: start of row plus u steps.
   const Vector3f ray_step = rotation.col(0) / static_cast<float>(camera_.fx);
-  // The floor test runs four pixels at a time in SSE2: the same single-precision operations
-  // in the same order as one pixel at a time (no FMA), so the same bits, with the three
-  // divisions per pixel done four at once. The row's rays are accumulated first, as before.
+  // Four pixels at a time in SSE2: the same single-precision operations in the same order as
+  // one pixel at a time (no FMA), so the same bits. The row's rays are accumulated first.
   const int w4 = (w + 3) / 4 * 4;
-  std::vector<float> row_x(w4, 0.0f), row_y(w4, 0.0f), row_z(w4, 0.0f);
-  const __m128 neg_oz4 = _mm_set1_ps(-o.z());
-  const __m128 ox4 = _mm_set1_ps(o.x()), oy4 = _mm_set1_ps(o.y());
-  const __m128 half4 = _mm_set1_ps(half_f), field4 = _mm_set1_ps(2.0f * half_f);
-  const __m128 tile4 = _mm_set1_ps(tile_f), zero4 = _mm_setzero_ps();
-  const __m128 seam_lo4 = _mm_set1_ps(kSeamM), seam_hi4 = _mm_set1_ps(tile_f - kSeamM);
-  const __m128 down4 = _mm_set1_ps(-1e-9f);
-  for (int v = 0; v < h; ++v) {
-    Vector3f d = rotation * rays_cam_[static_cast<size_t>(v) * w];
-    row_rays[v] = d;
-    for (int u = 0; u < w; ++u, d += ray_step) row_x[u] = d.x(), row_y[u] = d.y(), row_z[u] = d.z();
-    for (int u0 = 0; u0 < w; u0 += 4) {
-      const __m128 dx = _mm_loadu_ps(&row_x[u0]), dy = _mm_loadu_ps(&row_y[u0]);
-      const __m128 dz = _mm_loadu_ps(&row_z[u0]);
-      const __m128 t_floor = _mm_div_ps(neg_oz4, dz);
-      const __m128 px = _mm_add_ps(_mm_add_ps(ox4, _mm_mul_ps(t_floor, dx)), half4);
-      const __m128 py = _mm_add_ps(_mm_add_ps(oy4, _mm_mul_ps(t_floor, dy)), half4);
-      const __m128 on_floor =
-          _mm_and_ps(_mm_and_ps(_mm_cmplt_ps(dz, down4),
-                                _mm_and_ps(_mm_cmpge_ps(px, zero4), _mm_cmpge_ps(py, zero4))),
-                     _mm_and_ps(_mm_cmple_ps(px, field4), _mm_cmple_ps(py, field4)));
-      const int floor_lanes = _mm_movemask_ps(on_floor);
-      // Tiles: seams 4 mm wide, each tile's shade varied a little.
-      const __m128 fx = _mm_div_ps(px, tile4), fy = _mm_div_ps(py, tile4);
-      const __m128i ix4 = _mm_cvttps_epi32(fx), iy4 = _mm_cvttps_epi32(fy);
-      const __m128 sx = _mm_mul_ps(_mm_sub_ps(fx, _mm_cvtepi32_ps(ix4)), tile4);
-      const __m128 sy = _mm_mul_ps(_mm_sub_ps(fy, _mm_cvtepi32_ps(iy4)), tile4);
-      const __m128 seam4 =
-          _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(sx, seam_lo4), _mm_cmplt_ps(sy, seam_lo4)),
-                    _mm_or_ps(_mm_cmpgt_ps(sx, seam_hi4), _mm_cmpgt_ps(sy, seam_hi4)));
-      const int seam_lanes = _mm_movemask_ps(seam4);
-      alignas(16) float t_lane[4];
-      alignas(16) int32_t ix_lane[4], iy_lane[4];
-      _mm_store_ps(t_lane, t_floor);
-      _mm_store_si128(reinterpret_cast<__m128i*>(ix_lane), ix4);
-      _mm_store_si128(reinterpret_cast<__m128i*>(iy_lane), iy4);
-      for (int lane = 0; lane < 4 && u0 + lane < w; ++lane) {
-        const int u = u0 + lane;
-        const size_t i = static_cast<size_t>(v) * w + u;
+  // Four rows' rays at a time, one array of w4 per row.
+  std::vector<float> rays_x(4 * w4), rays_y(4 * w4), rays_z(4 * w4);
+  const F4 step_x(ray_step.x()), step_y(ray_step.y()), step_z(ray_step.z());
+  const F4 ox(o.x()), oy(o.y()), oz(o.z()), neg_oz(-o.z());
+  const F4 half4(half_f), field4(2.0f * half_f), tile4(tile_f), zero(0.0f), inf(kInf);
+  const F4 seam_lo(kSeamM), seam_hi(tile_f - kSeamM);
+  // The walls' planes as seen from the camera: x = +half (0), -half (1), y = +half (2), -half (3).
+  const F4 to_wall_x[2] = {half_f - o.x(), -half_f - o.x()};
+  const F4 to_wall_y[2] = {half_f - o.y(), -half_f - o.y()};
+  const __m128i hash_x = _mm_set1_epi32(73856093), hash_y = _mm_set1_epi32(19349663);
+  const M4 floor_black4 = {_mm_castsi128_ps(_mm_set1_epi32(floor_black ? -1 : 0))};
+  const M4 wall_black4 = {_mm_castsi128_ps(_mm_set1_epi32(wall_black ? -1 : 0))};
+  const M4 all_lanes = {_mm_castsi128_ps(_mm_set1_epi32(-1))};
+  for (int v0 = 0; v0 < h; v0 += 4) {
+    // The rays of four rows: each row's first ray, then u steps added one after another as
+    // one pixel at a time did, the four rows side by side in the lanes (four independent
+    // chains of additions instead of one), four steps at a time transposed into the rows.
+    const int rows = std::min(4, h - v0);
+    alignas(16) float first_x[4] = {}, first_y[4] = {}, first_z[4] = {};
+    for (int k = 0; k < rows; ++k) {
+      const Vector3f d = rotation * rays_cam_[static_cast<size_t>(v0 + k) * w];
+      row_rays[v0 + k] = d;
+      first_x[k] = d.x(), first_y[k] = d.y(), first_z[k] = d.z();
+    }
+    F4 ray4[3] = {F4(_mm_load_ps(first_x)), F4(_mm_load_ps(first_y)), F4(_mm_load_ps(first_z))};
+    const F4 steps[3] = {step_x, step_y, step_z};
+    float* const rays[3] = {rays_x.data(), rays_y.data(), rays_z.data()};
+    for (int u0 = 0; u0 < w4; u0 += 4) {
+      for (int c = 0; c < 3; ++c) {
+        __m128 s0 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        __m128 s1 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        __m128 s2 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        __m128 s3 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        _MM_TRANSPOSE4_PS(s0, s1, s2, s3);
+        _mm_storeu_ps(rays[c] + u0, s0), _mm_storeu_ps(rays[c] + w4 + u0, s1);
+        _mm_storeu_ps(rays[c] + 2 * w4 + u0, s2), _mm_storeu_ps(rays[c] + 3 * w4 + u0, s3);
+      }
+    }
+    for (int v = v0; v < v0 + rows; ++v) {
+      const float* row_x = rays_x.data() + (v - v0) * w4;
+      const float* row_y = rays_y.data() + (v - v0) * w4;
+      const float* row_z = rays_z.data() + (v - v0) * w4;
+      for (int u0 = 0; u0 < w; u0 += 4) {
+        const size_t i = static_cast<size_t>(v) * w + u0;
+        const F4 dx = Load4(&row_x[u0]), dy = Load4(&row_y[u0]), dz = Load4(&row_z[u0]);
+        const F4 t_floor = neg_oz / dz;
+        const F4 px = ox + t_floor * dx + half4, py = oy + t_floor * dy + half4;
         // A floor point inside the perimeter is reached before any wall (the camera is inside
-        // the field), so the walls are only tested for rays that miss the field's floor.
-        if (floor_lanes >> lane & 1) {
-          const int tile_hash = (ix_lane[lane] * 73856093) ^ (iy_lane[lane] * 19349663);
-          out->colour[i] =
-              floor_colour * ((seam_lanes >> lane & 1) ? 0.7f : tile_variation[tile_hash & 0xff]);
-          out->t[i] = t_lane[lane];
-          out->no_depth[i] = floor_black;
-          continue;
+        // the field), so the walls only matter for rays that miss the field's floor.
+        const M4 on_floor =
+            (dz < F4(-1e-9f)) & (px >= zero) & (py >= zero) & (px <= field4) & (py <= field4);
+        const int floor_lanes = Bits(on_floor);
+        F4 r = zero, g = zero, b = zero, t = zero;
+        M4 no_depth = floor_black4, wall_or_floor = on_floor;
+        if (floor_lanes) {
+          // Tiles: seams 4 mm wide, each tile's shade varied a little by its hash's low byte
+          // (which only the products' low 16 bits decide).
+          const F4 fx = px / tile4, fy = py / tile4;
+          const __m128i ix = _mm_cvttps_epi32(fx.m), iy = _mm_cvttps_epi32(fy.m);
+          const F4 sx = (fx - F4(_mm_cvtepi32_ps(ix))) * tile4;
+          const F4 sy = (fy - F4(_mm_cvtepi32_ps(iy))) * tile4;
+          const M4 seam = (sx < seam_lo) | (sy < seam_lo) | (sx > seam_hi) | (sy > seam_hi);
+          const __m128i hash =
+              _mm_and_si128(_mm_xor_si128(_mm_mullo_epi16(ix, hash_x), _mm_mullo_epi16(iy, hash_y)),
+                            _mm_set1_epi32(0xff));
+          const F4 variation = F4(0.96f) + F4(0.08f) * (F4(_mm_cvtepi32_ps(hash)) / F4(255.0f));
+          const F4 shade = Select(seam, 0.7f, variation);
+          r = F4(floor_colour.x()) * shade, g = F4(floor_colour.y()) * shade;
+          b = F4(floor_colour.z()) * shade, t = t_floor;
         }
-        const Vector3f d(row_x[u], row_y[u], row_z[u]);
-        // Nearest perimeter wall along the ray.
-        float t_wall = kInf;
-        int wall = 0;
-        if (d.x() > 1e-9f) t_wall = (half_f - o.x()) / d.x(), wall = 0;
-        if (d.x() < -1e-9f) t_wall = (-half_f - o.x()) / d.x(), wall = 1;
-        if (d.y() > 1e-9f) {
-          const float t = (half_f - o.y()) / d.y();
-          if (t < t_wall) t_wall = t, wall = 2;
-        }
-        if (d.y() < -1e-9f) {
-          const float t = (-half_f - o.y()) / d.y();
-          if (t < t_wall) t_wall = t, wall = 3;
-        }
-        if (t_wall < kInf && o.z() + t_wall * d.z() <= wall_h_f) {
-          out->colour[i] = wall_colour[wall];
-          out->t[i] = t_wall;
-          out->no_depth[i] = wall_black;
-        } else if (arena) {
-          ShadeArena(*arena, o, d, &out->colour[i], &out->t[i], &out->no_depth[i]);
-        } else {
+        if (floor_lanes != 0xf) {
+          // The nearest perimeter wall along the ray, then the venue above the walls.
+          const M4 pos_x = dx > F4(1e-9f), neg_x = dx < F4(-1e-9f);
+          const M4 pos_y = dy > F4(1e-9f), neg_y = dy < F4(-1e-9f);
+          const F4 t_x = Select(pos_x | neg_x, Select(pos_x, to_wall_x[0], to_wall_x[1]) / dx, inf);
+          const F4 t_y = Select(pos_y, to_wall_y[0], to_wall_y[1]) / dy;
+          const M4 use_y = (pos_y | neg_y) & (t_y < t_x);
+          const F4 t_wall = Select(use_y, t_y, t_x);
+          const M4 on_wall = AndNot((t_wall < inf) & (oz + t_wall * dz <= F4(wall_h_f)), on_floor);
+          const auto wall_channel = [&](int c) {
+            return Select(use_y, Select(pos_y, wall_colour[2][c], wall_colour[3][c]),
+                          Select(pos_x, wall_colour[0][c], wall_colour[1][c]));
+          };
           // The venue: dim, no depth within the camera's range.
-          const float g = 0.25f + 0.1f * std::max(0.0f, d.z() / d.norm());
-          out->colour[i] = Vector3f(g, g, g * 1.1f);
-          out->t[i] = kInf;
-          out->no_depth[i] = 1;
+          const F4 gray = F4(0.25f) + F4(0.1f) * MaxZero(dz / Sqrt(dx * dx + (dy * dy + dz * dz)));
+          const F4 venue_b = gray * F4(1.1f);
+          r = Select(on_floor, r, Select(on_wall, wall_channel(0), gray));
+          g = Select(on_floor, g, Select(on_wall, wall_channel(1), gray));
+          b = Select(on_floor, b, Select(on_wall, wall_channel(2), venue_b));
+          t = Select(on_floor, t, Select(on_wall, t_wall, inf));
+          no_depth = Select(on_floor, floor_black4, Select(on_wall, wall_black4, all_lanes));
+          wall_or_floor = on_floor | on_wall;
+        }
+        StoreRgb4(&out->colour[i], r, g, b);
+        _mm_storeu_ps(&out->t[i], t.m);
+        const __m128i flags16 = _mm_packs_epi32(_mm_castps_si128(no_depth.m), _mm_setzero_si128());
+        const int flags = _mm_cvtsi128_si32(
+            _mm_and_si128(_mm_packs_epi16(flags16, _mm_setzero_si128()), _mm_set1_epi8(1)));
+        std::memcpy(&out->no_depth[i], &flags, 4);
+        const int other_lanes = ~Bits(wall_or_floor) & 0xf;
+        if (arena && other_lanes) {
+          for (int lane = 0; lane < 4 && u0 + lane < w; ++lane) {
+            if (!(other_lanes >> lane & 1)) continue;
+            const Vector3f d(row_x[u0 + lane], row_y[u0 + lane], row_z[u0 + lane]);
+            ShadeArena(*arena, o, d, &out->colour[i + lane], &out->t[i + lane],
+                       &out->no_depth[i + lane]);
+          }
         }
       }
     }
@@ -751,7 +783,6 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   // lanes set where `p` is the nearest surface so far. The buffers hold three pixels beyond
   // the last, so a row's last group may read and write past its end (its lanes stay clear).
   const F4 lane_offsets(_mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f));
-  const F4 step_x(ray_step.x()), step_y(ray_step.y()), step_z(ray_step.z());
   const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) {
     const cv::Rect box = screen_box(p);
     const int u_end = box.x + box.width;
