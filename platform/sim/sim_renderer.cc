@@ -147,6 +147,45 @@ inline void StoreRgb4(Vector3f* p, F4 r, F4 g, F4 b) {
   _mm_storeu_ps(f, a), _mm_storeu_ps(f + 4, c), _mm_storeu_ps(f + 8, e);
 }
 
+// Two doubles in SSE2, as F4 for floats: the double-precision primitives two rays at a time.
+struct D2 {
+  __m128d m;
+  D2() = default;
+  explicit D2(__m128d v) : m(v) {}
+  D2(double x) : m(_mm_set1_pd(x)) {}  // NOLINT: constants as in the scalar expressions
+};
+inline D2 operator+(D2 a, D2 b) { return D2(_mm_add_pd(a.m, b.m)); }
+inline D2 operator-(D2 a, D2 b) { return D2(_mm_sub_pd(a.m, b.m)); }
+inline D2 operator*(D2 a, D2 b) { return D2(_mm_mul_pd(a.m, b.m)); }
+inline D2 operator/(D2 a, D2 b) { return D2(_mm_div_pd(a.m, b.m)); }
+inline D2 operator-(D2 a) { return D2(_mm_xor_pd(a.m, _mm_set1_pd(-0.0))); }
+inline D2 Sqrt(D2 a) { return D2(_mm_sqrt_pd(a.m)); }
+
+struct M2 {
+  __m128d m;
+};
+inline M2 operator<(D2 a, D2 b) { return {_mm_cmplt_pd(a.m, b.m)}; }
+inline M2 operator>(D2 a, D2 b) { return {_mm_cmpgt_pd(a.m, b.m)}; }
+inline M2 NotLess(D2 a, D2 b) { return {_mm_cmpnlt_pd(a.m, b.m)}; }
+inline M2 NotGreater(D2 a, D2 b) { return {_mm_cmpngt_pd(a.m, b.m)}; }
+inline M2 NotLessEqual(D2 a, D2 b) { return {_mm_cmpnle_pd(a.m, b.m)}; }
+inline M2 NotGreaterEqual(D2 a, D2 b) { return {_mm_cmpnge_pd(a.m, b.m)}; }
+inline M2 operator&(M2 a, M2 b) { return {_mm_and_pd(a.m, b.m)}; }
+inline M2 operator|(M2 a, M2 b) { return {_mm_or_pd(a.m, b.m)}; }
+inline D2 Select(M2 mask, D2 a, D2 b) {
+  return D2(_mm_or_pd(_mm_and_pd(mask.m, a.m), _mm_andnot_pd(mask.m, b.m)));
+}
+inline M2 Select(M2 mask, M2 a, M2 b) { return {Select(mask, D2(a.m), D2(b.m)).m}; }
+inline M2 IsFinite(D2 a) {
+  return {_mm_cmplt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), a.m),
+                       _mm_set1_pd(std::numeric_limits<double>::infinity()))};
+}
+// Two lanes each from two halves, back to four floats (the doubles rounded as static_cast).
+inline F4 ToF4(D2 lo, D2 hi) { return F4(_mm_movelh_ps(_mm_cvtpd_ps(lo.m), _mm_cvtpd_ps(hi.m))); }
+inline M4 ToM4(M2 lo, M2 hi) {
+  return {_mm_shuffle_ps(_mm_castpd_ps(lo.m), _mm_castpd_ps(hi.m), _MM_SHUFFLE(2, 0, 2, 0))};
+}
+
 double Luminance(const Vector3d& rgb) {
   return 0.299 * rgb.x() + 0.587 * rgb.y() + 0.114 * rgb.z();
 }
@@ -349,6 +388,71 @@ bool Intersect(const Primitive& p, const Vector3d& o, const Vector3d& d, double*
     }
   }
   return false;
+}
+
+// Intersect() for a cylinder or ring, two rays at a time: the same double operations in the
+// same order, so the same hits, depths and normals bit for bit. `hit` is Intersect's result
+// and `t` < `t_old`.
+struct Hit2 {
+  M2 hit;
+  D2 t, nx, ny, nz;
+};
+Hit2 IntersectCylinder2(const Primitive& p, const Vector3d& o, D2 dx, D2 dy, D2 dz, D2 t_old) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const M2 none{_mm_setzero_pd()};
+  // HitCylinderSide: radius r, the far (inner) candidate only when `inside`.
+  const auto side = [&](double r, bool inside) {
+    const double ox = o.x() - p.center.x(), oy = o.y() - p.center.y();
+    const D2 a = dx * dx + dy * dy;
+    const D2 b = D2(2.0) * (D2(ox) * dx + D2(oy) * dy);
+    const double cc = ox * ox + oy * oy - r * r;
+    const D2 disc = b * b - D2(4.0) * a * D2(cc);
+    const D2 sq = Sqrt(disc);
+    const D2 candidates[2] = {(-b - sq) / (D2(2.0) * a), (-b + sq) / (D2(2.0) * a)};
+    M2 ok[2];
+    for (int k = 0; k < 2; ++k) {
+      const D2 z = D2(o.z()) + candidates[k] * dz;
+      ok[k] = NotLessEqual(candidates[k], 1e-6) & NotLess(z, p.z0) & NotGreater(z, p.z1);
+    }
+    if (inside) ok[0] = none;
+    Hit2 h;
+    h.hit = NotLess(a, 1e-12) & NotLess(disc, 0.0) & (ok[0] | ok[1]);
+    h.t = Select(ok[0], candidates[0], candidates[1]);
+    // (hit - c, 0).normalized(): |.|^2 = hx^2 + (hy^2 + 0^2) = hx^2 + hy^2.
+    const D2 hx = D2(o.x()) + h.t * dx - D2(p.center.x());
+    const D2 hy = D2(o.y()) + h.t * dy - D2(p.center.y());
+    const D2 n2 = hx * hx + hy * hy;
+    const D2 n = Sqrt(n2);
+    const M2 positive = n2 > D2(0.0);
+    h.nx = Select(positive, hx / n, hx), h.ny = Select(positive, hy / n, hy), h.nz = 0.0;
+    if (inside) h.nx = -h.nx, h.ny = -h.ny, h.nz = -h.nz;
+    return h;
+  };
+  D2 best = inf, best_nx = 0.0, best_ny = 0.0, best_nz = 0.0;
+  const auto take = [&](M2 better, D2 t, D2 nx, D2 ny, D2 nz) {
+    best = Select(better, t, best), best_nx = Select(better, nx, best_nx);
+    best_ny = Select(better, ny, best_ny), best_nz = Select(better, nz, best_nz);
+  };
+  const Hit2 outer = side(p.radius, false);
+  take(outer.hit & (outer.t < best), outer.t, outer.nx, outer.ny, outer.nz);
+  if (p.kind == PrimitiveKind::kRing) {
+    const Hit2 inner = side(p.inner_radius, true);
+    take(inner.hit & (inner.t < best), inner.t, inner.nx, inner.ny, inner.nz);
+  }
+  // Caps, where |d.z| > 1e-12.
+  const M2 not_flat{_mm_cmpgt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), dz.m), _mm_set1_pd(1e-12))};
+  for (const double zc : {p.z1, p.z0}) {
+    const D2 tt = (D2(zc) - D2(o.z())) / dz;
+    const D2 cx = D2(o.x()) + tt * dx - D2(p.center.x());
+    const D2 cy = D2(o.y()) + tt * dy - D2(p.center.y());
+    const D2 r2 = cx * cx + cy * cy;
+    M2 inside = not_flat & NotLessEqual(tt, 1e-6) & NotGreaterEqual(tt, best) &
+                NotGreater(r2, p.radius * p.radius);
+    if (p.kind == PrimitiveKind::kRing)
+      inside = inside & NotLess(r2, p.inner_radius * p.inner_radius);
+    take(inside, tt, 0.0, 0.0, zc == p.z1 ? 1.0 : -1.0);
+  }
+  return {IsFinite(best) & (best < t_old), best, best_nx, best_ny, best_nz};
 }
 
 Primitive ObjectPrimitive(const field::SeasonConfig& season, const SimObject& object) {
@@ -863,6 +967,24 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
         on_hit(
             i, hit, d, t_near,
             V3{Select(side, cy * lx - sy * ly, zero), Select(side, sy * lx + cy * ly, zero), lz});
+      });
+      return;
+    }
+    if (p.kind == PrimitiveKind::kCylinder || p.kind == PrimitiveKind::kRing) {
+      // Cylinders and rings in double precision, two rays at a time.
+      for_each_group([&](size_t i, M4 lanes, const V3& d) {
+        const __m128 t_old = _mm_loadu_ps(&out->t[i]);
+        const auto half = [&](int shift) {
+          const auto wide = [&](__m128 x) {
+            return D2(_mm_cvtps_pd(shift ? _mm_movehl_ps(x, x) : x));
+          };
+          return IntersectCylinder2(p, origin, wide(d.x.m), wide(d.y.m), wide(d.z.m), wide(t_old));
+        };
+        const Hit2 lo = half(0), hi = half(1);
+        const M4 hit = lanes & ToM4(lo.hit, hi.hit);
+        if (!Bits(hit)) return;
+        on_hit(i, hit, d, ToF4(lo.t, hi.t),
+               V3{ToF4(lo.nx, hi.nx), ToF4(lo.ny, hi.ny), ToF4(lo.nz, hi.nz)});
       });
       return;
     }
