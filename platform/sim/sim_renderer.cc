@@ -716,6 +716,13 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   const M4 floor_black4 = {_mm_castsi128_ps(_mm_set1_epi32(floor_black ? -1 : 0))};
   const M4 wall_black4 = {_mm_castsi128_ps(_mm_set1_epi32(wall_black ? -1 : 0))};
   const M4 all_lanes = {_mm_castsi128_ps(_mm_set1_epi32(-1))};
+  const __m128 floor_rgbr =
+      _mm_setr_ps(floor_colour.x(), floor_colour.y(), floor_colour.z(), floor_colour.x());
+  const __m128 floor_gbrg =
+      _mm_setr_ps(floor_colour.y(), floor_colour.z(), floor_colour.x(), floor_colour.y());
+  const __m128 floor_brgb =
+      _mm_setr_ps(floor_colour.z(), floor_colour.x(), floor_colour.y(), floor_colour.z());
+  const int floor_flags = floor_black ? 0x01010101 : 0;
   for (int v0 = 0; v0 < h; v0 += 4) {
     // The rays of four rows: each row's first ray, then u steps added one after another as
     // one pixel at a time did, the four rows side by side in the lanes (four independent
@@ -774,6 +781,20 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
                             _mm_set1_epi32(0xff));
           const F4 variation = F4(0.96f) + F4(0.08f) * (F4(_mm_cvtepi32_ps(hash)) / F4(255.0f));
           const F4 shade = Select(seam, 0.7f, variation);
+          if (floor_lanes == 0xf) {
+            // All floor: floor_colour * shade straight into RGB order, (r g b r) * (s0 s0 s0 s1)
+            // and so on.
+            const __m128 s0 = _mm_shuffle_ps(shade.m, shade.m, _MM_SHUFFLE(1, 0, 0, 0));
+            const __m128 s1 = _mm_shuffle_ps(shade.m, shade.m, _MM_SHUFFLE(2, 2, 1, 1));
+            const __m128 s2 = _mm_shuffle_ps(shade.m, shade.m, _MM_SHUFFLE(3, 3, 3, 2));
+            float* colour = out->colour[i].data();
+            _mm_storeu_ps(colour, _mm_mul_ps(floor_rgbr, s0));
+            _mm_storeu_ps(colour + 4, _mm_mul_ps(floor_gbrg, s1));
+            _mm_storeu_ps(colour + 8, _mm_mul_ps(floor_brgb, s2));
+            _mm_storeu_ps(&out->t[i], t_floor.m);
+            std::memcpy(&out->no_depth[i], &floor_flags, 4);
+            continue;
+          }
           r = F4(floor_colour.x()) * shade, g = F4(floor_colour.y()) * shade;
           b = F4(floor_colour.z()) * shade, t = t_floor;
         }
@@ -793,12 +814,16 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
           // The venue: dim, no depth within the camera's range.
           const F4 gray = F4(0.25f) + F4(0.1f) * MaxZero(dz / Sqrt(dx * dx + (dy * dy + dz * dz)));
           const F4 venue_b = gray * F4(1.1f);
-          r = Select(on_floor, r, Select(on_wall, wall_channel(0), gray));
-          g = Select(on_floor, g, Select(on_wall, wall_channel(1), gray));
-          b = Select(on_floor, b, Select(on_wall, wall_channel(2), venue_b));
-          t = Select(on_floor, t, Select(on_wall, t_wall, inf));
-          no_depth = Select(on_floor, floor_black4, Select(on_wall, wall_black4, all_lanes));
           wall_or_floor = on_floor | on_wall;
+          if (!Bits(wall_or_floor)) {  // all venue
+            r = g = gray, b = venue_b, t = inf, no_depth = all_lanes;
+          } else {
+            r = Select(on_floor, r, Select(on_wall, wall_channel(0), gray));
+            g = Select(on_floor, g, Select(on_wall, wall_channel(1), gray));
+            b = Select(on_floor, b, Select(on_wall, wall_channel(2), venue_b));
+            t = Select(on_floor, t, Select(on_wall, t_wall, inf));
+            no_depth = Select(on_floor, floor_black4, Select(on_wall, wall_black4, all_lanes));
+          }
         }
         StoreRgb4(&out->colour[i], r, g, b);
         _mm_storeu_ps(&out->t[i], t.m);
@@ -1013,21 +1038,42 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
              V3{F4(_mm_load_ps(nx)), F4(_mm_load_ps(ny)), F4(_mm_load_ps(nz))});
     });
   };
-  // Writes the hit lanes of four pixels: depth, id, colour and the no-depth flag.
-  const auto store = [&](size_t i, M4 hit, F4 t, int id, const V3& c, M4 no_depth) {
-    _mm_storeu_ps(&out->t[i], Select(hit, t, Load4(&out->t[i])).m);
-    const __m128i hit16 = _mm_packs_epi32(_mm_castps_si128(hit.m), _mm_castps_si128(hit.m));
-    __m128i* id_at = reinterpret_cast<__m128i*>(&out->id[i]);
+  // Writes the hit lanes of four pixels: depth, id, colour and the no-depth flag; `behind`,
+  // when given, is what the colour buffer holds there.
+  const auto store = [&](size_t i, M4 hit, F4 t, int id, const V3& c, M4 no_depth,
+                         const V3* behind = nullptr) {
     const __m128i ids = _mm_set1_epi16(static_cast<int16_t>(static_cast<uint16_t>(id)));
+    __m128i* id_at = reinterpret_cast<__m128i*>(&out->id[i]);
+    // The flags as four bytes 0 or 1.
+    const __m128i flags16 = _mm_packs_epi32(_mm_castps_si128(no_depth.m), _mm_setzero_si128());
+    const __m128i flags8 =
+        _mm_and_si128(_mm_packs_epi16(flags16, _mm_setzero_si128()), _mm_set1_epi8(1));
+    if (Bits(hit) == 0xf) {  // all four: nothing to keep
+      _mm_storeu_ps(&out->t[i], t.m);
+      _mm_storel_epi64(id_at, ids);
+      StoreRgb4(&out->colour[i], c.x, c.y, c.z);
+      const int flags = _mm_cvtsi128_si32(flags8);
+      std::memcpy(&out->no_depth[i], &flags, 4);
+      return;
+    }
+    _mm_storeu_ps(&out->t[i], Select(hit, t, Load4(&out->t[i])).m);
+    const __m128i hit16 = _mm_packs_epi32(_mm_castps_si128(hit.m), _mm_setzero_si128());
     _mm_storel_epi64(id_at, _mm_or_si128(_mm_and_si128(hit16, ids),
                                          _mm_andnot_si128(hit16, _mm_loadl_epi64(id_at))));
-    F4 r, g, b;
-    LoadRgb4(&out->colour[i], &r, &g, &b);
-    StoreRgb4(&out->colour[i], Select(hit, c.x, r), Select(hit, c.y, g), Select(hit, c.z, b));
-    const int hits = Bits(hit), flags = Bits(no_depth);
-    for (int k = 0; k < 4; ++k) {
-      if (hits >> k & 1) out->no_depth[i + k] = flags >> k & 1;
+    V3 old;
+    if (behind) {
+      old = *behind;
+    } else {
+      LoadRgb4(&out->colour[i], &old.x, &old.y, &old.z);
     }
+    StoreRgb4(&out->colour[i], Select(hit, c.x, old.x), Select(hit, c.y, old.y),
+              Select(hit, c.z, old.z));
+    const __m128i hit8 = _mm_packs_epi16(hit16, _mm_setzero_si128());
+    int old_flags;
+    std::memcpy(&old_flags, &out->no_depth[i], 4);
+    const int flags = _mm_cvtsi128_si32(_mm_or_si128(
+        _mm_and_si128(hit8, flags8), _mm_andnot_si128(hit8, _mm_cvtsi32_si128(old_flags))));
+    std::memcpy(&out->no_depth[i], &flags, 4);
   };
   const V3 to_light{to_light_f.x(), to_light_f.y(), to_light_f.z()};
   const F4 ambient4(ambient_f), diffuse4(diffuse_f);
@@ -1116,7 +1162,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
       }
       const F4 keep = F4(1.0f) - patch, glare = patch * F4(0.85f);
       c = V3{keep * c.x + glare + spec, keep * c.y + glare + spec, keep * c.z + glare + spec};
-      store(i, hit, t, p.id, c, spec > dropout4);
+      store(i, hit, t, p.id, c, spec > dropout4, &behind);
     });
   }
 }
