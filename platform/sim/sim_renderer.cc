@@ -400,6 +400,19 @@ struct Hit2 {
 Hit2 IntersectCylinder2(const Primitive& p, const Vector3d& o, D2 dx, D2 dy, D2 dz, D2 t_old) {
   const double inf = std::numeric_limits<double>::infinity();
   const M2 none{_mm_setzero_pd()};
+  // Rays whose line passes the axis farther than the (outer) radius, by a margin of 1e-6 that
+  // is orders of magnitude above the rounding of either test, meet neither the side (their
+  // discriminant is negative) nor a cap (no point of the line is within the radius): when
+  // both rays do, Intersect() says no for both and nothing else need be computed. Squared
+  // distance from the axis: ((o - c) x d)^2 / |d|^2 in the plane; near-vertical rays (|d|^2
+  // in the plane below 1e-9) are left to the full test.
+  {
+    const double ox = o.x() - p.center.x(), oy = o.y() - p.center.y();
+    const D2 a = dx * dx + dy * dy;
+    const D2 cross = D2(ox) * dy - D2(oy) * dx;
+    const M2 away = (a > D2(1e-9)) & (cross * cross > D2(p.radius * p.radius * (1.0 + 1e-6)) * a);
+    if (_mm_movemask_pd(away.m) == 3) return {none, 0.0, 0.0, 0.0, 0.0};
+  }
   // HitCylinderSide: radius r, the far (inner) candidate only when `inside`.
   const auto side = [&](double r, bool inside) {
     const double ox = o.x() - p.center.x(), oy = o.y() - p.center.y();
@@ -937,9 +950,10 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
         const F4 b = Dot(oc, d);
         const F4 a = Load4(&ray_length2_[i]);
         const F4 disc = b * b - a * c;
+        const M4 meets = lanes & NotLess(disc, 0.0f);
+        if (!Bits(meets)) return;  // no square root or division for groups beside the sphere
         const F4 t = (-b - Sqrt(disc)) / a;
-        const M4 hit = lanes & NotLess(disc, 0.0f) & NotLessEqual(t, 1e-6f) &
-                       NotGreaterEqual(t, Load4(&out->t[i]));
+        const M4 hit = meets & NotLessEqual(t, 1e-6f) & NotGreaterEqual(t, Load4(&out->t[i]));
         if (!Bits(hit)) return;
         on_hit(i, hit, d, t,
                V3{(oc.x + t * d.x) * inv_r, (oc.y + t * d.y) * inv_r, (oc.z + t * d.z) * inv_r});
