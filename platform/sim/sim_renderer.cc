@@ -18,6 +18,14 @@ namespace slamo::platform {
 using Eigen::Vector3d;
 using Eigen::Vector3f;
 
+// The render pass is compiled twice, for AVX and for plain x86-64, and the CPU picks one when
+// the program starts (function multi-versioning). AVX only brings the VEX encoding here (three
+// operands, fewer register copies): the same operations in the same order and no FMA (AVX has
+// none), so both versions compute the same bits. The pass's lambdas are inlined into it to be
+// compiled for AVX too.
+#define SLAMO_ALWAYS_INLINE __attribute__((always_inline))
+#define SLAMO_AVX_CLONES __attribute__((target_clones("avx", "default")))
+
 enum class PrimitiveKind { kSphere, kBox, kCylinder, kRing, kPlate, kPrism };
 
 struct SimRenderer::Primitive {
@@ -175,7 +183,6 @@ inline M2 operator|(M2 a, M2 b) { return {_mm_or_pd(a.m, b.m)}; }
 inline D2 Select(M2 mask, D2 a, D2 b) {
   return D2(_mm_or_pd(_mm_and_pd(mask.m, a.m), _mm_andnot_pd(mask.m, b.m)));
 }
-inline M2 Select(M2 mask, M2 a, M2 b) { return {Select(mask, D2(a.m), D2(b.m)).m}; }
 inline M2 IsFinite(D2 a) {
   return {_mm_cmplt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), a.m),
                        _mm_set1_pd(std::numeric_limits<double>::infinity()))};
@@ -397,7 +404,8 @@ struct Hit2 {
   M2 hit;
   D2 t, nx, ny, nz;
 };
-Hit2 IntersectCylinder2(const Primitive& p, const Vector3d& o, D2 dx, D2 dy, D2 dz, D2 t_old) {
+inline SLAMO_ALWAYS_INLINE Hit2 IntersectCylinder2(const Primitive& p, const Vector3d& o, D2 dx,
+                                                   D2 dy, D2 dz, D2 t_old) {
   const double inf = std::numeric_limits<double>::infinity();
   const M2 none{_mm_setzero_pd()};
   // Rays whose line passes the axis farther than the (outer) radius, by a margin of 1e-6 that
@@ -670,8 +678,9 @@ double SimRenderer::DepthSigmaM(double depth_m) const {
   return platform::DepthSigmaM(camera_, depth_m);
 }
 
-void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& world_from_camera,
-                             const ArenaBackdrop* arena, Buffers* out) const {
+SLAMO_AVX_CLONES void SimRenderer::RenderPass(const SimWorld& world,
+                                              const Eigen::Isometry3d& world_from_camera,
+                                              const ArenaBackdrop* arena, Buffers* out) const {
   const int w = camera_.width_px;
   const int h = camera_.height_px;
   out->Reset(w, h);
@@ -925,10 +934,10 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   // lanes set where `p` is the nearest surface so far. The buffers hold three pixels beyond
   // the last, so a row's last group may read and write past its end (its lanes stay clear).
   const F4 lane_offsets(_mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f));
-  const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) {
+  const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) SLAMO_ALWAYS_INLINE {
     const cv::Rect box = screen_box(p);
     const int u_end = box.x + box.width;
-    const auto for_each_group = [&](auto&& group) {
+    const auto for_each_group = [&](auto&& group) SLAMO_ALWAYS_INLINE {
       for (int v = box.y; v < box.y + box.height; ++v) {
         const F4 row_x(row_rays[v].x()), row_y(row_rays[v].y()), row_z(row_rays[v].z());
         for (int u0 = box.x; u0 < u_end; u0 += 4) {
@@ -946,7 +955,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
       const V3 oc{oc_f.x(), oc_f.y(), oc_f.z()};
       const F4 c = oc_f.squaredNorm() - static_cast<float>(p.radius * p.radius);
       const F4 inv_r = static_cast<float>(1.0 / p.radius);
-      for_each_group([&](size_t i, M4 lanes, const V3& d) {
+      for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
         const F4 b = Dot(oc, d);
         const F4 a = Load4(&ray_length2_[i]);
         const F4 disc = b * b - a * c;
@@ -974,7 +983,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
       const F4 hi_b[3] = {static_cast<float>(p.half_x), static_cast<float>(p.half_y),
                           static_cast<float>(p.z1)};
       const F4 zero(0.0f), one(1.0f), minus_one(-1.0f);
-      for_each_group([&](size_t i, M4 lanes, const V3& d) {
+      for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
         const F4 ld[3] = {cy * d.x + sy * d.y, neg_sy * d.x + cy * d.y, d.z};
         F4 t_near = -kInf, t_far = kInf;
         // The slab test per axis; a lane that misses on one axis stops there, one pixel at a
@@ -1011,10 +1020,10 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     }
     if (p.kind == PrimitiveKind::kCylinder || p.kind == PrimitiveKind::kRing) {
       // Cylinders and rings in double precision, two rays at a time.
-      for_each_group([&](size_t i, M4 lanes, const V3& d) {
+      for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
         const __m128 t_old = _mm_loadu_ps(&out->t[i]);
-        const auto half = [&](int shift) {
-          const auto wide = [&](__m128 x) {
+        const auto half = [&](int shift) SLAMO_ALWAYS_INLINE {
+          const auto wide = [&](__m128 x) SLAMO_ALWAYS_INLINE {
             return D2(_mm_cvtps_pd(shift ? _mm_movehl_ps(x, x) : x));
           };
           return IntersectCylinder2(p, origin, wide(d.x.m), wide(d.y.m), wide(d.z.m), wide(t_old));
@@ -1028,7 +1037,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
       return;
     }
     // Everything else in double precision, one pixel at a time, shaded four at a time.
-    for_each_group([&](size_t i, M4 lanes, const V3& d) {
+    for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
       alignas(16) float dx[4], dy[4], dz[4], t_lane[4], nx[4], ny[4], nz[4];
       _mm_store_ps(dx, d.x.m), _mm_store_ps(dy, d.y.m), _mm_store_ps(dz, d.z.m);
       const int valid = Bits(lanes);
@@ -1055,7 +1064,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   // Writes the hit lanes of four pixels: depth, id, colour and the no-depth flag; `behind`,
   // when given, is what the colour buffer holds there.
   const auto store = [&](size_t i, M4 hit, F4 t, int id, const V3& c, M4 no_depth,
-                         const V3* behind = nullptr) {
+                         const V3* behind = nullptr) SLAMO_ALWAYS_INLINE {
     const __m128i ids = _mm_set1_epi16(static_cast<int16_t>(static_cast<uint16_t>(id)));
     __m128i* id_at = reinterpret_cast<__m128i*>(&out->id[i]);
     // The flags as four bytes 0 or 1.
@@ -1092,7 +1101,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   const V3 to_light{to_light_f.x(), to_light_f.y(), to_light_f.z()};
   const F4 ambient4(ambient_f), diffuse4(diffuse_f);
   // shade_f for four normals: albedo * tint * (ambient + diffuse * max(0, n . l)).
-  const auto shade4 = [&](const Vector3f& albedo_tint, const V3& n) {
+  const auto shade4 = [&](const Vector3f& albedo_tint, const V3& n) SLAMO_ALWAYS_INLINE {
     const F4 lambert = ambient4 + diffuse4 * MaxZero(Dot(n, to_light));
     return V3{F4(albedo_tint.x()) * lambert, F4(albedo_tint.y()) * lambert,
               F4(albedo_tint.z()) * lambert};
@@ -1101,7 +1110,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     const Vector3f albedo_tint = p.albedo.cast<float>().cwiseProduct(tint_f);
     const M4 black{
         _mm_castsi128_ps(_mm_set1_epi32(Luminance(p.albedo) < options_.black_albedo ? -1 : 0))};
-    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) {
+    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) SLAMO_ALWAYS_INLINE {
       V3 c = shade4(albedo_tint, n);
       if (p.glossy) {
         // Facing away from the half vector (n . h <= 0 before normalising), n . h / |h| is at
@@ -1136,7 +1145,7 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     const F4 clear = 1.0f - static_cast<float>(p.opacity);
     const Vector3f albedo_tint = p.albedo.cast<float>().cwiseProduct(tint_f);
     const Vector3f filter = Vector3f::Constant(0.35f) + 0.65f * tint;
-    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) {
+    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) SLAMO_ALWAYS_INLINE {
       const V3 dn = Normalized(d);
       const V3 view{-dn.x, -dn.y, -dn.z};
       // Thin tinted plastic: the background shows through, filtered by the tint.
@@ -1181,8 +1190,8 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   }
 }
 
-RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double t_s,
-                              FrameTruth* truth) {
+SLAMO_AVX_CLONES RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot,
+                                               double t_s, FrameTruth* truth) {
   const int w = camera_.width_px;
   const int h = camera_.height_px;
   const Eigen::Isometry3d world_from_camera = CameraPose(robot);
