@@ -573,7 +573,7 @@ struct SimRenderer::Buffers {
     width = w, height = h;
     const size_t n = static_cast<size_t>(w) * h;
     // Kept between frames: resizing is a no-op after the first, so no fresh pages per frame.
-    // Three pixels more than the image: the passes work on four pixels at a time.
+    // kPad pixels more than the image: the passes work on four pixels at a time.
     t.resize(n + kPad), colour.resize(n + kPad), id.resize(n + kPad), no_depth.resize(n + kPad);
     row_rays.resize(h);
     // t, colour and no_depth are written for every pixel by the floor pass.
@@ -599,7 +599,7 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
       ray_length2_.push_back(rays_cam_.back().squaredNorm());
     }
   }
-  ray_length2_.resize(ray_length2_.size() + kPad, 1.0f);  // read four pixels at a time
+  ray_length2_.resize(ray_length2_.size() + kPad, 1.0f);  // read four pixels at a time (kPad)
   // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
   // without a normal draw per pixel per frame. The pool holds four frames' worth of pixels
   // (at least 2^20), so a frame's colour noise (3 per pixel) always fits after an offset.
@@ -931,7 +931,7 @@ SLAMO_AVX_CLONES void SimRenderer::RenderPass(const SimWorld& world,
     return cv::Rect(iu0, iv0, iu1 - iu0 + 1, iv1 - iv0 + 1);
   };
   // Calls on_hit(first pixel, lanes, rays, t, normals) for four pixels of a row at a time, the
-  // lanes set where `p` is the nearest surface so far. The buffers hold three pixels beyond
+  // lanes set where `p` is the nearest surface so far. The buffers hold kPad pixels beyond
   // the last, so a row's last group may read and write past its end (its lanes stay clear).
   const F4 lane_offsets(_mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f));
   const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) SLAMO_ALWAYS_INLINE {
