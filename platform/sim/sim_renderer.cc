@@ -463,6 +463,13 @@ inline SLAMO_ALWAYS_INLINE Hit2 IntersectCylinder2(const Primitive& p, const Vec
   // Caps, where |d.z| > 1e-12.
   const M2 not_flat{_mm_cmpgt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), dz.m), _mm_set1_pd(1e-12))};
   for (const double zc : {p.z1, p.z0}) {
+    // tt = (zc - o.z) / d.z is positive only where d.z has the sign of zc - o.z; elsewhere it
+    // is <= 0 and the cap is not taken, so a pair of rays that both head away skips it.
+    const double rise = zc - o.z();
+    const M2 toward{rise > 0.0   ? _mm_cmpgt_pd(dz.m, _mm_setzero_pd())
+                    : rise < 0.0 ? _mm_cmplt_pd(dz.m, _mm_setzero_pd())
+                                 : _mm_setzero_pd()};
+    if (!_mm_movemask_pd((not_flat & toward).m)) continue;
     const D2 tt = (D2(zc) - D2(o.z())) / dz;
     const D2 cx = D2(o.x()) + tt * dx - D2(p.center.x());
     const D2 cy = D2(o.y()) + tt * dy - D2(p.center.y());
