@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <limits>
 
 #include <emmintrin.h>
@@ -16,6 +17,14 @@ namespace slamo::platform {
 
 using Eigen::Vector3d;
 using Eigen::Vector3f;
+
+// The render pass is compiled twice, for AVX and for plain x86-64, and the CPU picks one when
+// the program starts (function multi-versioning). AVX only brings the VEX encoding here (three
+// operands, fewer register copies): the same operations in the same order and no FMA (AVX has
+// none), so both versions compute the same bits. The pass's lambdas are inlined into it to be
+// compiled for AVX too.
+#define SLAMO_ALWAYS_INLINE __attribute__((always_inline))
+#define SLAMO_AVX_CLONES __attribute__((target_clones("avx", "default")))
 
 enum class PrimitiveKind { kSphere, kBox, kCylinder, kRing, kPlate, kPrism };
 
@@ -43,21 +52,145 @@ namespace {
 using Primitive = SimRenderer::Primitive;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// Buffers hold this many pixels beyond the image, for the passes' four-pixel groups.
+constexpr size_t kPad = 4;
 
 Vector3d Albedo(const field::SeasonConfig& season, const std::string& colour) {
   const field::Rgb& c = season.colours.at(colour);
   return Vector3d(c.r, c.g, c.b) / 255.0;
 }
 
+// Four floats in SSE2 registers with the operators of float: each lane rounds exactly as the
+// scalar code does (SSE2 has no FMA and nothing here reassociates), so four pixels shaded at
+// once get the bits one pixel at a time got. Eigen's fixed-size 3-vector reductions add as
+// x + (y + z); Dot and Normalized below do the same.
+struct F4 {
+  __m128 m;
+  F4() = default;
+  explicit F4(__m128 v) : m(v) {}
+  F4(float x) : m(_mm_set1_ps(x)) {}  // NOLINT: constants as in the scalar expressions
+};
+inline F4 operator+(F4 a, F4 b) { return F4(_mm_add_ps(a.m, b.m)); }
+inline F4 operator-(F4 a, F4 b) { return F4(_mm_sub_ps(a.m, b.m)); }
+inline F4 operator*(F4 a, F4 b) { return F4(_mm_mul_ps(a.m, b.m)); }
+inline F4 operator/(F4 a, F4 b) { return F4(_mm_div_ps(a.m, b.m)); }
+inline F4 operator-(F4 a) { return F4(_mm_xor_ps(a.m, _mm_set1_ps(-0.0f))); }
+inline F4 Sqrt(F4 a) { return F4(_mm_sqrt_ps(a.m)); }
+inline F4 MaxZero(F4 a) { return F4(_mm_max_ps(a.m, _mm_setzero_ps())); }  // std::max(0.0f, a)
+inline F4 MinOne(F4 a) { return F4(_mm_min_ps(a.m, _mm_set1_ps(1.0f))); }  // std::min(1.0f, a)
+inline F4 Load4(const float* p) { return F4(_mm_loadu_ps(p)); }
+
+struct M4 {  // a lane mask: all ones or all zeros
+  __m128 m;
+};
+inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.m, b.m)}; }
+inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.m, b.m)}; }
+inline M4 operator<=(F4 a, F4 b) { return {_mm_cmple_ps(a.m, b.m)}; }
+inline M4 operator>=(F4 a, F4 b) { return {_mm_cmpge_ps(a.m, b.m)}; }
+inline M4 operator==(F4 a, F4 b) { return {_mm_cmpeq_ps(a.m, b.m)}; }
+// The negated comparisons, true for NaN as `if (a < b) continue;` lets NaN through.
+inline M4 NotLess(F4 a, F4 b) { return {_mm_cmpnlt_ps(a.m, b.m)}; }
+inline M4 NotLessEqual(F4 a, F4 b) { return {_mm_cmpnle_ps(a.m, b.m)}; }
+inline M4 NotGreaterEqual(F4 a, F4 b) { return {_mm_cmpnge_ps(a.m, b.m)}; }
+inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.m, b.m)}; }
+inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.m, b.m)}; }
+inline M4 AndNot(M4 a, M4 b) { return {_mm_andnot_ps(b.m, a.m)}; }  // a & ~b
+inline int Bits(M4 a) { return _mm_movemask_ps(a.m); }
+inline F4 Select(M4 mask, F4 a, F4 b) {
+  return F4(_mm_or_ps(_mm_and_ps(mask.m, a.m), _mm_andnot_ps(mask.m, b.m)));
+}
+inline M4 Select(M4 mask, M4 a, M4 b) { return {Select(mask, F4(a.m), F4(b.m)).m}; }
+
+struct V3 {
+  F4 x, y, z;
+};
+inline F4 Dot(const V3& a, const V3& b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
+// Eigen's normalized(): v / |v|, or v itself when |v|^2 is not positive.
+inline V3 Normalized(const V3& v) {
+  const F4 n2 = Dot(v, v);
+  const F4 n = Sqrt(n2);
+  const M4 positive = n2 > F4(0.0f);
+  return {Select(positive, v.x / n, v.x), Select(positive, v.y / n, v.y),
+          Select(positive, v.z / n, v.z)};
+}
 // x^n by squaring (n >= 0): the highlight exponents, without std::pow per pixel.
-float PowInt(float x, int n) {
-  float result = 1.0f;
+inline F4 PowInt4(F4 x, int n) {
+  F4 result(1.0f);
   while (n > 0) {
-    if (n & 1) result *= x;
-    x *= x;
+    if (n & 1) result = result * x;
+    x = x * x;
     n >>= 1;
   }
   return result;
+}
+
+// Four consecutive RGB pixels (12 floats) to and from one register per channel.
+inline void LoadRgb4(const Vector3f* p, F4* r, F4* g, F4* b) {
+  const float* f = p->data();
+  const __m128 a = _mm_loadu_ps(f), c = _mm_loadu_ps(f + 4), e = _mm_loadu_ps(f + 8);
+  // a = r0 g0 b0 r1, c = g1 b1 r2 g2, e = b2 r3 g3 b3
+  const __m128 ce_r = _mm_shuffle_ps(c, e, _MM_SHUFFLE(1, 1, 2, 2));  // r2 r2 r3 r3
+  const __m128 ac_g = _mm_shuffle_ps(a, c, _MM_SHUFFLE(0, 0, 1, 1));  // g0 g0 g1 g1
+  const __m128 ce_g = _mm_shuffle_ps(c, e, _MM_SHUFFLE(2, 2, 3, 3));  // g2 g2 g3 g3
+  const __m128 ac_b = _mm_shuffle_ps(a, c, _MM_SHUFFLE(1, 1, 2, 2));  // b0 b0 b1 b1
+  const __m128 ee_b = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 3, 0, 0));  // b2 b2 b3 b3
+  r->m = _mm_shuffle_ps(a, ce_r, _MM_SHUFFLE(2, 0, 3, 0));
+  g->m = _mm_shuffle_ps(ac_g, ce_g, _MM_SHUFFLE(2, 0, 2, 0));
+  b->m = _mm_shuffle_ps(ac_b, ee_b, _MM_SHUFFLE(2, 0, 2, 0));
+}
+inline void StoreRgb4(Vector3f* p, F4 r, F4 g, F4 b) {
+  float* f = p->data();
+  const __m128 rg_lo = _mm_unpacklo_ps(r.m, g.m);  // r0 g0 r1 g1
+  const __m128 rg_hi = _mm_unpackhi_ps(r.m, g.m);  // r2 g2 r3 g3
+  // r0 g0 b0 r1
+  const __m128 b0r1 = _mm_shuffle_ps(b.m, r.m, _MM_SHUFFLE(1, 1, 0, 0));  // b0 b0 r1 r1
+  const __m128 a = _mm_shuffle_ps(rg_lo, b0r1, _MM_SHUFFLE(2, 0, 1, 0));
+  // g1 b1 r2 g2
+  const __m128 g1b1 = _mm_shuffle_ps(g.m, b.m, _MM_SHUFFLE(1, 1, 1, 1));  // g1 g1 b1 b1
+  const __m128 c = _mm_shuffle_ps(g1b1, rg_hi, _MM_SHUFFLE(1, 0, 2, 0));
+  // b2 r3 g3 b3
+  const __m128 b2r3 = _mm_shuffle_ps(b.m, r.m, _MM_SHUFFLE(3, 3, 2, 2));  // b2 b2 r3 r3
+  const __m128 g3b3 = _mm_shuffle_ps(g.m, b.m, _MM_SHUFFLE(3, 3, 3, 3));  // g3 g3 b3 b3
+  const __m128 e = _mm_shuffle_ps(b2r3, g3b3, _MM_SHUFFLE(2, 0, 2, 0));
+  _mm_storeu_ps(f, a), _mm_storeu_ps(f + 4, c), _mm_storeu_ps(f + 8, e);
+}
+
+// Two doubles in SSE2, as F4 for floats: the double-precision primitives two rays at a time.
+struct D2 {
+  __m128d m;
+  D2() = default;
+  explicit D2(__m128d v) : m(v) {}
+  D2(double x) : m(_mm_set1_pd(x)) {}  // NOLINT: constants as in the scalar expressions
+};
+inline D2 operator+(D2 a, D2 b) { return D2(_mm_add_pd(a.m, b.m)); }
+inline D2 operator-(D2 a, D2 b) { return D2(_mm_sub_pd(a.m, b.m)); }
+inline D2 operator*(D2 a, D2 b) { return D2(_mm_mul_pd(a.m, b.m)); }
+inline D2 operator/(D2 a, D2 b) { return D2(_mm_div_pd(a.m, b.m)); }
+inline D2 operator-(D2 a) { return D2(_mm_xor_pd(a.m, _mm_set1_pd(-0.0))); }
+inline D2 Sqrt(D2 a) { return D2(_mm_sqrt_pd(a.m)); }
+
+struct M2 {
+  __m128d m;
+};
+inline M2 operator<(D2 a, D2 b) { return {_mm_cmplt_pd(a.m, b.m)}; }
+inline M2 operator>(D2 a, D2 b) { return {_mm_cmpgt_pd(a.m, b.m)}; }
+inline M2 NotLess(D2 a, D2 b) { return {_mm_cmpnlt_pd(a.m, b.m)}; }
+inline M2 NotGreater(D2 a, D2 b) { return {_mm_cmpngt_pd(a.m, b.m)}; }
+inline M2 NotLessEqual(D2 a, D2 b) { return {_mm_cmpnle_pd(a.m, b.m)}; }
+inline M2 NotGreaterEqual(D2 a, D2 b) { return {_mm_cmpnge_pd(a.m, b.m)}; }
+inline M2 operator&(M2 a, M2 b) { return {_mm_and_pd(a.m, b.m)}; }
+inline M2 operator|(M2 a, M2 b) { return {_mm_or_pd(a.m, b.m)}; }
+inline D2 Select(M2 mask, D2 a, D2 b) {
+  return D2(_mm_or_pd(_mm_and_pd(mask.m, a.m), _mm_andnot_pd(mask.m, b.m)));
+}
+inline M2 IsFinite(D2 a) {
+  return {_mm_cmplt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), a.m),
+                       _mm_set1_pd(std::numeric_limits<double>::infinity()))};
+}
+// Two lanes each from two halves, back to four floats (the doubles rounded as static_cast).
+inline F4 ToF4(D2 lo, D2 hi) { return F4(_mm_movelh_ps(_mm_cvtpd_ps(lo.m), _mm_cvtpd_ps(hi.m))); }
+inline M4 ToM4(M2 lo, M2 hi) {
+  return {_mm_shuffle_ps(_mm_castpd_ps(lo.m), _mm_castpd_ps(hi.m), _MM_SHUFFLE(2, 0, 2, 0))};
 }
 
 double Luminance(const Vector3d& rgb) {
@@ -264,6 +397,92 @@ bool Intersect(const Primitive& p, const Vector3d& o, const Vector3d& d, double*
   return false;
 }
 
+// Intersect() for a cylinder or ring, two rays at a time: the same double operations in the
+// same order, so the same hits, depths and normals bit for bit. `hit` is Intersect's result
+// and `t` < `t_old`.
+struct Hit2 {
+  M2 hit;
+  D2 t, nx, ny, nz;
+};
+inline SLAMO_ALWAYS_INLINE Hit2 IntersectCylinder2(const Primitive& p, const Vector3d& o, D2 dx,
+                                                   D2 dy, D2 dz, D2 t_old) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const M2 none{_mm_setzero_pd()};
+  // Rays whose line passes the axis farther than the (outer) radius, by a margin of 1e-6 that
+  // is orders of magnitude above the rounding of either test, meet neither the side (their
+  // discriminant is negative) nor a cap (no point of the line is within the radius): when
+  // both rays do, Intersect() says no for both and nothing else need be computed. Squared
+  // distance from the axis: ((o - c) x d)^2 / |d|^2 in the plane; near-vertical rays (|d|^2
+  // in the plane below 1e-9) are left to the full test.
+  {
+    const double ox = o.x() - p.center.x(), oy = o.y() - p.center.y();
+    const D2 a = dx * dx + dy * dy;
+    const D2 cross = D2(ox) * dy - D2(oy) * dx;
+    const M2 away = (a > D2(1e-9)) & (cross * cross > D2(p.radius * p.radius * (1.0 + 1e-6)) * a);
+    if (_mm_movemask_pd(away.m) == 3) return {none, 0.0, 0.0, 0.0, 0.0};
+  }
+  // HitCylinderSide: radius r, the far (inner) candidate only when `inside`.
+  const auto side = [&](double r, bool inside) {
+    const double ox = o.x() - p.center.x(), oy = o.y() - p.center.y();
+    const D2 a = dx * dx + dy * dy;
+    const D2 b = D2(2.0) * (D2(ox) * dx + D2(oy) * dy);
+    const double cc = ox * ox + oy * oy - r * r;
+    const D2 disc = b * b - D2(4.0) * a * D2(cc);
+    const D2 sq = Sqrt(disc);
+    const D2 candidates[2] = {(-b - sq) / (D2(2.0) * a), (-b + sq) / (D2(2.0) * a)};
+    M2 ok[2];
+    for (int k = 0; k < 2; ++k) {
+      const D2 z = D2(o.z()) + candidates[k] * dz;
+      ok[k] = NotLessEqual(candidates[k], 1e-6) & NotLess(z, p.z0) & NotGreater(z, p.z1);
+    }
+    if (inside) ok[0] = none;
+    Hit2 h;
+    h.hit = NotLess(a, 1e-12) & NotLess(disc, 0.0) & (ok[0] | ok[1]);
+    h.t = Select(ok[0], candidates[0], candidates[1]);
+    // (hit - c, 0).normalized(): |.|^2 = hx^2 + (hy^2 + 0^2) = hx^2 + hy^2.
+    const D2 hx = D2(o.x()) + h.t * dx - D2(p.center.x());
+    const D2 hy = D2(o.y()) + h.t * dy - D2(p.center.y());
+    const D2 n2 = hx * hx + hy * hy;
+    const D2 n = Sqrt(n2);
+    const M2 positive = n2 > D2(0.0);
+    h.nx = Select(positive, hx / n, hx), h.ny = Select(positive, hy / n, hy), h.nz = 0.0;
+    if (inside) h.nx = -h.nx, h.ny = -h.ny, h.nz = -h.nz;
+    return h;
+  };
+  D2 best = inf, best_nx = 0.0, best_ny = 0.0, best_nz = 0.0;
+  const auto take = [&](M2 better, D2 t, D2 nx, D2 ny, D2 nz) {
+    best = Select(better, t, best), best_nx = Select(better, nx, best_nx);
+    best_ny = Select(better, ny, best_ny), best_nz = Select(better, nz, best_nz);
+  };
+  const Hit2 outer = side(p.radius, false);
+  take(outer.hit & (outer.t < best), outer.t, outer.nx, outer.ny, outer.nz);
+  if (p.kind == PrimitiveKind::kRing) {
+    const Hit2 inner = side(p.inner_radius, true);
+    take(inner.hit & (inner.t < best), inner.t, inner.nx, inner.ny, inner.nz);
+  }
+  // Caps, where |d.z| > 1e-12.
+  const M2 not_flat{_mm_cmpgt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), dz.m), _mm_set1_pd(1e-12))};
+  for (const double zc : {p.z1, p.z0}) {
+    // tt = (zc - o.z) / d.z is positive only where d.z has the sign of zc - o.z; elsewhere it
+    // is <= 0 and the cap is not taken, so a pair of rays that both head away skips it.
+    const double rise = zc - o.z();
+    const M2 toward{rise > 0.0   ? _mm_cmpgt_pd(dz.m, _mm_setzero_pd())
+                    : rise < 0.0 ? _mm_cmplt_pd(dz.m, _mm_setzero_pd())
+                                 : _mm_setzero_pd()};
+    if (!_mm_movemask_pd((not_flat & toward).m)) continue;
+    const D2 tt = (D2(zc) - D2(o.z())) / dz;
+    const D2 cx = D2(o.x()) + tt * dx - D2(p.center.x());
+    const D2 cy = D2(o.y()) + tt * dy - D2(p.center.y());
+    const D2 r2 = cx * cx + cy * cy;
+    M2 inside = not_flat & NotLessEqual(tt, 1e-6) & NotGreaterEqual(tt, best) &
+                NotGreater(r2, p.radius * p.radius);
+    if (p.kind == PrimitiveKind::kRing)
+      inside = inside & NotLess(r2, p.inner_radius * p.inner_radius);
+    take(inside, tt, 0.0, 0.0, zc == p.z1 ? 1.0 : -1.0);
+  }
+  return {IsFinite(best) & (best < t_old), best, best_nx, best_ny, best_nz};
+}
+
 Primitive ObjectPrimitive(const field::SeasonConfig& season, const SimObject& object) {
   const field::ObjectType& type = *object.type;
   Primitive p;
@@ -361,9 +580,11 @@ struct SimRenderer::Buffers {
     width = w, height = h;
     const size_t n = static_cast<size_t>(w) * h;
     // Kept between frames: resizing is a no-op after the first, so no fresh pages per frame.
-    t.resize(n), colour.resize(n), id.resize(n), no_depth.resize(n), row_rays.resize(h);
+    // kPad pixels more than the image: the passes work on four pixels at a time.
+    t.resize(n + kPad), colour.resize(n + kPad), id.resize(n + kPad), no_depth.resize(n + kPad);
+    row_rays.resize(h);
     // t, colour and no_depth are written for every pixel by the floor pass.
-    std::fill(id.begin(), id.end(), uint16_t{0});
+    std::fill(id.begin(), id.begin() + n, uint16_t{0});
   }
 };
 
@@ -385,6 +606,7 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
       ray_length2_.push_back(rays_cam_.back().squaredNorm());
     }
   }
+  ray_length2_.resize(ray_length2_.size() + kPad, 1.0f);  // read four pixels at a time (kPad)
   // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
   // without a normal draw per pixel per frame. The pool holds four frames' worth of pixels
   // (at least 2^20), so a frame's colour noise (3 per pixel) always fits after an offset.
@@ -463,8 +685,9 @@ double SimRenderer::DepthSigmaM(double depth_m) const {
   return platform::DepthSigmaM(camera_, depth_m);
 }
 
-void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& world_from_camera,
-                             const ArenaBackdrop* arena, Buffers* out) const {
+SLAMO_AVX_CLONES void SimRenderer::RenderPass(const SimWorld& world,
+                                              const Eigen::Isometry3d& world_from_camera,
+                                              const ArenaBackdrop* arena, Buffers* out) const {
   const int w = camera_.width_px;
   const int h = camera_.height_px;
   out->Reset(w, h);
@@ -504,91 +727,147 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
   const bool floor_black = Luminance(tile_albedo) < options_.black_albedo;
   const bool wall_black = Luminance(wall_albedo) < options_.black_albedo;
   constexpr float kSeamM = 0.004f;
-  // Each tile's shade factor by its hash's low byte: the same float as computed per pixel,
-  // without a division per floor pixel.
-  float tile_variation[256];
-  for (int k = 0; k < 256; ++k) tile_variation[k] = 0.96f + 0.08f * (k / 255.0f);
   // The world ray is linear in u along a row: start of row plus u steps.
   const Vector3f ray_step = rotation.col(0) / static_cast<float>(camera_.fx);
-  // The floor test runs four pixels at a time in SSE2: the same single-precision operations
-  // in the same order as one pixel at a time (no FMA), so the same bits, with the three
-  // divisions per pixel done four at once. The row's rays are accumulated first, as before.
+  // Four pixels at a time in SSE2: the same single-precision operations in the same order as
+  // one pixel at a time (no FMA), so the same bits. The row's rays are accumulated first.
   const int w4 = (w + 3) / 4 * 4;
-  std::vector<float> row_x(w4, 0.0f), row_y(w4, 0.0f), row_z(w4, 0.0f);
-  const __m128 neg_oz4 = _mm_set1_ps(-o.z());
-  const __m128 ox4 = _mm_set1_ps(o.x()), oy4 = _mm_set1_ps(o.y());
-  const __m128 half4 = _mm_set1_ps(half_f), field4 = _mm_set1_ps(2.0f * half_f);
-  const __m128 tile4 = _mm_set1_ps(tile_f), zero4 = _mm_setzero_ps();
-  const __m128 seam_lo4 = _mm_set1_ps(kSeamM), seam_hi4 = _mm_set1_ps(tile_f - kSeamM);
-  const __m128 down4 = _mm_set1_ps(-1e-9f);
-  for (int v = 0; v < h; ++v) {
-    Vector3f d = rotation * rays_cam_[static_cast<size_t>(v) * w];
-    row_rays[v] = d;
-    for (int u = 0; u < w; ++u, d += ray_step) row_x[u] = d.x(), row_y[u] = d.y(), row_z[u] = d.z();
-    for (int u0 = 0; u0 < w; u0 += 4) {
-      const __m128 dx = _mm_loadu_ps(&row_x[u0]), dy = _mm_loadu_ps(&row_y[u0]);
-      const __m128 dz = _mm_loadu_ps(&row_z[u0]);
-      const __m128 t_floor = _mm_div_ps(neg_oz4, dz);
-      const __m128 px = _mm_add_ps(_mm_add_ps(ox4, _mm_mul_ps(t_floor, dx)), half4);
-      const __m128 py = _mm_add_ps(_mm_add_ps(oy4, _mm_mul_ps(t_floor, dy)), half4);
-      const __m128 on_floor =
-          _mm_and_ps(_mm_and_ps(_mm_cmplt_ps(dz, down4),
-                                _mm_and_ps(_mm_cmpge_ps(px, zero4), _mm_cmpge_ps(py, zero4))),
-                     _mm_and_ps(_mm_cmple_ps(px, field4), _mm_cmple_ps(py, field4)));
-      const int floor_lanes = _mm_movemask_ps(on_floor);
-      // Tiles: seams 4 mm wide, each tile's shade varied a little.
-      const __m128 fx = _mm_div_ps(px, tile4), fy = _mm_div_ps(py, tile4);
-      const __m128i ix4 = _mm_cvttps_epi32(fx), iy4 = _mm_cvttps_epi32(fy);
-      const __m128 sx = _mm_mul_ps(_mm_sub_ps(fx, _mm_cvtepi32_ps(ix4)), tile4);
-      const __m128 sy = _mm_mul_ps(_mm_sub_ps(fy, _mm_cvtepi32_ps(iy4)), tile4);
-      const __m128 seam4 =
-          _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(sx, seam_lo4), _mm_cmplt_ps(sy, seam_lo4)),
-                    _mm_or_ps(_mm_cmpgt_ps(sx, seam_hi4), _mm_cmpgt_ps(sy, seam_hi4)));
-      const int seam_lanes = _mm_movemask_ps(seam4);
-      alignas(16) float t_lane[4];
-      alignas(16) int32_t ix_lane[4], iy_lane[4];
-      _mm_store_ps(t_lane, t_floor);
-      _mm_store_si128(reinterpret_cast<__m128i*>(ix_lane), ix4);
-      _mm_store_si128(reinterpret_cast<__m128i*>(iy_lane), iy4);
-      for (int lane = 0; lane < 4 && u0 + lane < w; ++lane) {
-        const int u = u0 + lane;
-        const size_t i = static_cast<size_t>(v) * w + u;
+  // Four rows' rays at a time, one array of w4 per row.
+  std::vector<float> rays_x(4 * w4), rays_y(4 * w4), rays_z(4 * w4);
+  const F4 step_x(ray_step.x()), step_y(ray_step.y()), step_z(ray_step.z());
+  const F4 ox(o.x()), oy(o.y()), oz(o.z()), neg_oz(-o.z());
+  const F4 half4(half_f), field4(2.0f * half_f), tile4(tile_f), zero(0.0f), inf(kInf);
+  const F4 seam_lo(kSeamM), seam_hi(tile_f - kSeamM);
+  // The walls' planes as seen from the camera: x = +half (0), -half (1), y = +half (2), -half (3).
+  const F4 to_wall_x[2] = {half_f - o.x(), -half_f - o.x()};
+  const F4 to_wall_y[2] = {half_f - o.y(), -half_f - o.y()};
+  const __m128i hash_x = _mm_set1_epi32(73856093), hash_y = _mm_set1_epi32(19349663);
+  const M4 floor_black4 = {_mm_castsi128_ps(_mm_set1_epi32(floor_black ? -1 : 0))};
+  const M4 wall_black4 = {_mm_castsi128_ps(_mm_set1_epi32(wall_black ? -1 : 0))};
+  const M4 all_lanes = {_mm_castsi128_ps(_mm_set1_epi32(-1))};
+  const __m128 floor_rgbr =
+      _mm_setr_ps(floor_colour.x(), floor_colour.y(), floor_colour.z(), floor_colour.x());
+  const __m128 floor_gbrg =
+      _mm_setr_ps(floor_colour.y(), floor_colour.z(), floor_colour.x(), floor_colour.y());
+  const __m128 floor_brgb =
+      _mm_setr_ps(floor_colour.z(), floor_colour.x(), floor_colour.y(), floor_colour.z());
+  const int floor_flags = floor_black ? 0x01010101 : 0;
+  for (int v0 = 0; v0 < h; v0 += 4) {
+    // The rays of four rows: each row's first ray, then u steps added one after another as
+    // one pixel at a time did, the four rows side by side in the lanes (four independent
+    // chains of additions instead of one), four steps at a time transposed into the rows.
+    const int rows = std::min(4, h - v0);
+    alignas(16) float first_x[4] = {}, first_y[4] = {}, first_z[4] = {};
+    for (int k = 0; k < rows; ++k) {
+      const Vector3f d = rotation * rays_cam_[static_cast<size_t>(v0 + k) * w];
+      row_rays[v0 + k] = d;
+      first_x[k] = d.x(), first_y[k] = d.y(), first_z[k] = d.z();
+    }
+    F4 ray4[3] = {F4(_mm_load_ps(first_x)), F4(_mm_load_ps(first_y)), F4(_mm_load_ps(first_z))};
+    const F4 steps[3] = {step_x, step_y, step_z};
+    float* const rays[3] = {rays_x.data(), rays_y.data(), rays_z.data()};
+    for (int u0 = 0; u0 < w4; u0 += 4) {
+      for (int c = 0; c < 3; ++c) {
+        __m128 s0 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        __m128 s1 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        __m128 s2 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        __m128 s3 = ray4[c].m;
+        ray4[c] = ray4[c] + steps[c];
+        _MM_TRANSPOSE4_PS(s0, s1, s2, s3);
+        _mm_storeu_ps(rays[c] + u0, s0), _mm_storeu_ps(rays[c] + w4 + u0, s1);
+        _mm_storeu_ps(rays[c] + 2 * w4 + u0, s2), _mm_storeu_ps(rays[c] + 3 * w4 + u0, s3);
+      }
+    }
+    for (int v = v0; v < v0 + rows; ++v) {
+      const float* row_x = rays_x.data() + (v - v0) * w4;
+      const float* row_y = rays_y.data() + (v - v0) * w4;
+      const float* row_z = rays_z.data() + (v - v0) * w4;
+      for (int u0 = 0; u0 < w; u0 += 4) {
+        const size_t i = static_cast<size_t>(v) * w + u0;
+        const F4 dx = Load4(&row_x[u0]), dy = Load4(&row_y[u0]), dz = Load4(&row_z[u0]);
+        const F4 t_floor = neg_oz / dz;
+        const F4 px = ox + t_floor * dx + half4, py = oy + t_floor * dy + half4;
         // A floor point inside the perimeter is reached before any wall (the camera is inside
-        // the field), so the walls are only tested for rays that miss the field's floor.
-        if (floor_lanes >> lane & 1) {
-          const int tile_hash = (ix_lane[lane] * 73856093) ^ (iy_lane[lane] * 19349663);
-          out->colour[i] =
-              floor_colour * ((seam_lanes >> lane & 1) ? 0.7f : tile_variation[tile_hash & 0xff]);
-          out->t[i] = t_lane[lane];
-          out->no_depth[i] = floor_black;
-          continue;
+        // the field), so the walls only matter for rays that miss the field's floor.
+        const M4 on_floor =
+            (dz < F4(-1e-9f)) & (px >= zero) & (py >= zero) & (px <= field4) & (py <= field4);
+        const int floor_lanes = Bits(on_floor);
+        F4 r = zero, g = zero, b = zero, t = zero;
+        M4 no_depth = floor_black4, wall_or_floor = on_floor;
+        if (floor_lanes) {
+          // Tiles: seams 4 mm wide, each tile's shade varied a little by its hash's low byte
+          // (which only the products' low 16 bits decide).
+          const F4 fx = px / tile4, fy = py / tile4;
+          const __m128i ix = _mm_cvttps_epi32(fx.m), iy = _mm_cvttps_epi32(fy.m);
+          const F4 sx = (fx - F4(_mm_cvtepi32_ps(ix))) * tile4;
+          const F4 sy = (fy - F4(_mm_cvtepi32_ps(iy))) * tile4;
+          const M4 seam = (sx < seam_lo) | (sy < seam_lo) | (sx > seam_hi) | (sy > seam_hi);
+          const __m128i hash =
+              _mm_and_si128(_mm_xor_si128(_mm_mullo_epi16(ix, hash_x), _mm_mullo_epi16(iy, hash_y)),
+                            _mm_set1_epi32(0xff));
+          const F4 variation = F4(0.96f) + F4(0.08f) * (F4(_mm_cvtepi32_ps(hash)) / F4(255.0f));
+          const F4 shade = Select(seam, 0.7f, variation);
+          if (floor_lanes == 0xf) {
+            // All floor: floor_colour * shade straight into RGB order, (r g b r) * (s0 s0 s0 s1)
+            // and so on.
+            const __m128 s0 = _mm_shuffle_ps(shade.m, shade.m, _MM_SHUFFLE(1, 0, 0, 0));
+            const __m128 s1 = _mm_shuffle_ps(shade.m, shade.m, _MM_SHUFFLE(2, 2, 1, 1));
+            const __m128 s2 = _mm_shuffle_ps(shade.m, shade.m, _MM_SHUFFLE(3, 3, 3, 2));
+            float* colour = out->colour[i].data();
+            _mm_storeu_ps(colour, _mm_mul_ps(floor_rgbr, s0));
+            _mm_storeu_ps(colour + 4, _mm_mul_ps(floor_gbrg, s1));
+            _mm_storeu_ps(colour + 8, _mm_mul_ps(floor_brgb, s2));
+            _mm_storeu_ps(&out->t[i], t_floor.m);
+            std::memcpy(&out->no_depth[i], &floor_flags, 4);
+            continue;
+          }
+          r = F4(floor_colour.x()) * shade, g = F4(floor_colour.y()) * shade;
+          b = F4(floor_colour.z()) * shade, t = t_floor;
         }
-        const Vector3f d(row_x[u], row_y[u], row_z[u]);
-        // Nearest perimeter wall along the ray.
-        float t_wall = kInf;
-        int wall = 0;
-        if (d.x() > 1e-9f) t_wall = (half_f - o.x()) / d.x(), wall = 0;
-        if (d.x() < -1e-9f) t_wall = (-half_f - o.x()) / d.x(), wall = 1;
-        if (d.y() > 1e-9f) {
-          const float t = (half_f - o.y()) / d.y();
-          if (t < t_wall) t_wall = t, wall = 2;
-        }
-        if (d.y() < -1e-9f) {
-          const float t = (-half_f - o.y()) / d.y();
-          if (t < t_wall) t_wall = t, wall = 3;
-        }
-        if (t_wall < kInf && o.z() + t_wall * d.z() <= wall_h_f) {
-          out->colour[i] = wall_colour[wall];
-          out->t[i] = t_wall;
-          out->no_depth[i] = wall_black;
-        } else if (arena) {
-          ShadeArena(*arena, o, d, &out->colour[i], &out->t[i], &out->no_depth[i]);
-        } else {
+        if (floor_lanes != 0xf) {
+          // The nearest perimeter wall along the ray, then the venue above the walls.
+          const M4 pos_x = dx > F4(1e-9f), neg_x = dx < F4(-1e-9f);
+          const M4 pos_y = dy > F4(1e-9f), neg_y = dy < F4(-1e-9f);
+          const F4 t_x = Select(pos_x | neg_x, Select(pos_x, to_wall_x[0], to_wall_x[1]) / dx, inf);
+          const F4 t_y = Select(pos_y, to_wall_y[0], to_wall_y[1]) / dy;
+          const M4 use_y = (pos_y | neg_y) & (t_y < t_x);
+          const F4 t_wall = Select(use_y, t_y, t_x);
+          const M4 on_wall = AndNot((t_wall < inf) & (oz + t_wall * dz <= F4(wall_h_f)), on_floor);
+          const auto wall_channel = [&](int c) {
+            return Select(use_y, Select(pos_y, wall_colour[2][c], wall_colour[3][c]),
+                          Select(pos_x, wall_colour[0][c], wall_colour[1][c]));
+          };
           // The venue: dim, no depth within the camera's range.
-          const float g = 0.25f + 0.1f * std::max(0.0f, d.z() / d.norm());
-          out->colour[i] = Vector3f(g, g, g * 1.1f);
-          out->t[i] = kInf;
-          out->no_depth[i] = 1;
+          const F4 gray = F4(0.25f) + F4(0.1f) * MaxZero(dz / Sqrt(dx * dx + (dy * dy + dz * dz)));
+          const F4 venue_b = gray * F4(1.1f);
+          wall_or_floor = on_floor | on_wall;
+          if (!Bits(wall_or_floor)) {  // all venue
+            r = g = gray, b = venue_b, t = inf, no_depth = all_lanes;
+          } else {
+            r = Select(on_floor, r, Select(on_wall, wall_channel(0), gray));
+            g = Select(on_floor, g, Select(on_wall, wall_channel(1), gray));
+            b = Select(on_floor, b, Select(on_wall, wall_channel(2), venue_b));
+            t = Select(on_floor, t, Select(on_wall, t_wall, inf));
+            no_depth = Select(on_floor, floor_black4, Select(on_wall, wall_black4, all_lanes));
+          }
+        }
+        StoreRgb4(&out->colour[i], r, g, b);
+        _mm_storeu_ps(&out->t[i], t.m);
+        const __m128i flags16 = _mm_packs_epi32(_mm_castps_si128(no_depth.m), _mm_setzero_si128());
+        const int flags = _mm_cvtsi128_si32(
+            _mm_and_si128(_mm_packs_epi16(flags16, _mm_setzero_si128()), _mm_set1_epi8(1)));
+        std::memcpy(&out->no_depth[i], &flags, 4);
+        const int other_lanes = ~Bits(wall_or_floor) & 0xf;
+        if (arena && other_lanes) {
+          for (int lane = 0; lane < 4 && u0 + lane < w; ++lane) {
+            if (!(other_lanes >> lane & 1)) continue;
+            const Vector3f d(row_x[u0 + lane], row_y[u0 + lane], row_z[u0 + lane]);
+            ShadeArena(*arena, o, d, &out->colour[i + lane], &out->t[i + lane],
+                       &out->no_depth[i + lane]);
+          }
         }
       }
     }
@@ -658,104 +937,201 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     if (iu1 < iu0 || iv1 < iv0) return cv::Rect();
     return cv::Rect(iu0, iv0, iu1 - iu0 + 1, iv1 - iv0 + 1);
   };
-  // Calls on_hit(pixel, ray, t, normal) for each pixel where `p` is the nearest surface so far.
-  const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) {
+  // Calls on_hit(first pixel, lanes, rays, t, normals) for four pixels of a row at a time, the
+  // lanes set where `p` is the nearest surface so far. The buffers hold kPad pixels beyond
+  // the last, so a row's last group may read and write past its end (its lanes stay clear).
+  const F4 lane_offsets(_mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f));
+  const auto for_each_hit = [&](const Primitive& p, auto&& on_hit) SLAMO_ALWAYS_INLINE {
     const cv::Rect box = screen_box(p);
+    const int u_end = box.x + box.width;
+    const auto for_each_group = [&](auto&& group) SLAMO_ALWAYS_INLINE {
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        const F4 row_x(row_rays[v].x()), row_y(row_rays[v].y()), row_z(row_rays[v].z());
+        for (int u0 = box.x; u0 < u_end; u0 += 4) {
+          const F4 u = F4(static_cast<float>(u0)) + lane_offsets;  // exact: small integers
+          // The ray as one pixel at a time: start of row plus u steps.
+          const V3 d{row_x + u * step_x, row_y + u * step_y, row_z + u * step_z};
+          group(static_cast<size_t>(v) * w + u0, u < F4(static_cast<float>(u_end)), d);
+        }
+      }
+    };
     if (p.kind == PrimitiveKind::kSphere) {
       // Spheres, the most common object, in single precision: |d|^2 is the camera ray's
       // (rotation keeps lengths), so a hit costs a dot product and a square root.
-      const Vector3f oc = (origin - p.center).cast<float>();
-      const float c = oc.squaredNorm() - static_cast<float>(p.radius * p.radius);
-      const float inv_r = static_cast<float>(1.0 / p.radius);
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          const size_t i = static_cast<size_t>(v) * w + u;
-          const Vector3f d = row_rays[v] + static_cast<float>(u) * ray_step;
-          const float b = oc.dot(d);
-          const float a = ray_length2_[i];
-          const float disc = b * b - a * c;
-          if (disc < 0.0f) continue;
-          const float t = (-b - std::sqrt(disc)) / a;
-          if (t <= 1e-6f || t >= out->t[i]) continue;
-          on_hit(i, d, t, Vector3f((oc + t * d) * inv_r));
-        }
-      }
+      const Vector3f oc_f = (origin - p.center).cast<float>();
+      const V3 oc{oc_f.x(), oc_f.y(), oc_f.z()};
+      const F4 c = oc_f.squaredNorm() - static_cast<float>(p.radius * p.radius);
+      const F4 inv_r = static_cast<float>(1.0 / p.radius);
+      for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
+        const F4 b = Dot(oc, d);
+        const F4 a = Load4(&ray_length2_[i]);
+        const F4 disc = b * b - a * c;
+        const M4 meets = lanes & NotLess(disc, 0.0f);
+        if (!Bits(meets)) return;  // no square root or division for groups beside the sphere
+        const F4 t = (-b - Sqrt(disc)) / a;
+        const M4 hit = meets & NotLessEqual(t, 1e-6f) & NotGreaterEqual(t, Load4(&out->t[i]));
+        if (!Bits(hit)) return;
+        on_hit(i, hit, d, t,
+               V3{(oc.x + t * d.x) * inv_r, (oc.y + t * d.y) * inv_r, (oc.z + t * d.z) * inv_r});
+      });
       return;
     }
     if (p.kind == PrimitiveKind::kBox) {
       // Boxes (structures, cubes, opponents) in single precision, in the box's own frame.
-      const float cy = static_cast<float>(p.cos_yaw), sy = static_cast<float>(p.sin_yaw);
+      const F4 cy = static_cast<float>(p.cos_yaw), sy = static_cast<float>(p.sin_yaw);
+      const F4 neg_sy = -static_cast<float>(p.sin_yaw);
       const float rx = static_cast<float>(origin.x() - p.center.x());
       const float ry = static_cast<float>(origin.y() - p.center.y());
-      const float lo_o[3] = {cy * rx + sy * ry, -sy * rx + cy * ry, static_cast<float>(origin.z())};
-      const float lo_b[3] = {static_cast<float>(-p.half_x), static_cast<float>(-p.half_y),
-                             static_cast<float>(p.z0)};
-      const float hi_b[3] = {static_cast<float>(p.half_x), static_cast<float>(p.half_y),
-                             static_cast<float>(p.z1)};
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          const size_t i = static_cast<size_t>(v) * w + u;
-          const Vector3f d = row_rays[v] + static_cast<float>(u) * ray_step;
-          const float ld[3] = {cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y(), d.z()};
-          float t_near = -kInf, t_far = kInf;
-          int axis = -1;
-          float sign = 1.0f;
-          bool miss = false;
-          for (int k = 0; k < 3 && !miss; ++k) {
-            if (std::abs(ld[k]) < 1e-12f) {
-              miss = lo_o[k] < lo_b[k] || lo_o[k] > hi_b[k];
-              continue;
-            }
-            const float inv = 1.0f / ld[k];
-            float t0 = (lo_b[k] - lo_o[k]) * inv, t1 = (hi_b[k] - lo_o[k]) * inv;
-            float sg = -1.0f;
-            if (t0 > t1) std::swap(t0, t1), sg = 1.0f;
-            if (t0 > t_near) t_near = t0, axis = k, sign = sg;
-            t_far = std::min(t_far, t1);
-            miss = t_near > t_far;
-          }
-          if (miss || axis < 0 || t_near <= 1e-6f || t_near >= out->t[i]) continue;
-          Vector3f n = Vector3f::Zero();
-          if (axis == 2) {
-            n.z() = sign;
-          } else {
-            const float lx = axis == 0 ? sign : 0.0f, ly = axis == 1 ? sign : 0.0f;
-            n = Vector3f(cy * lx - sy * ly, sy * lx + cy * ly, 0.0f);
-          }
-          on_hit(i, d, t_near, n);
+      const float cy_f = static_cast<float>(p.cos_yaw), sy_f = static_cast<float>(p.sin_yaw);
+      const F4 lo_o[3] = {cy_f * rx + sy_f * ry, -sy_f * rx + cy_f * ry,
+                          static_cast<float>(origin.z())};
+      const F4 lo_b[3] = {static_cast<float>(-p.half_x), static_cast<float>(-p.half_y),
+                          static_cast<float>(p.z0)};
+      const F4 hi_b[3] = {static_cast<float>(p.half_x), static_cast<float>(p.half_y),
+                          static_cast<float>(p.z1)};
+      const F4 zero(0.0f), one(1.0f), minus_one(-1.0f);
+      for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
+        const F4 ld[3] = {cy * d.x + sy * d.y, neg_sy * d.x + cy * d.y, d.z};
+        F4 t_near = -kInf, t_far = kInf;
+        // The slab test per axis; a lane that misses on one axis stops there, one pixel at a
+        // time, so its miss is kept whatever the later axes say.
+        M4 miss{_mm_setzero_ps()}, has_axis{_mm_setzero_ps()};
+        F4 lx = zero, ly = zero, lz = zero;  // the entry face's local normal
+        for (int k = 0; k < 3; ++k) {
+          const M4 parallel = F4(_mm_andnot_ps(_mm_set1_ps(-0.0f), ld[k].m)) < F4(1e-12f);
+          const M4 outside = (lo_o[k] < lo_b[k]) | (lo_o[k] > hi_b[k]);
+          const F4 inv = one / ld[k];
+          const F4 t0 = (lo_b[k] - lo_o[k]) * inv, t1 = (hi_b[k] - lo_o[k]) * inv;
+          const M4 swap = t0 > t1;
+          const F4 near_k = Select(swap, t1, t0), far_k = Select(swap, t0, t1);
+          const F4 sign = Select(swap, one, minus_one);
+          const M4 enter = AndNot(near_k > t_near, parallel);
+          t_near = Select(enter, near_k, t_near);
+          lx = Select(enter, k == 0 ? sign : zero, lx);
+          ly = Select(enter, k == 1 ? sign : zero, ly);
+          lz = Select(enter, k == 2 ? sign : zero, lz);
+          has_axis = has_axis | enter;
+          t_far = Select(parallel, t_far, F4(_mm_min_ps(far_k.m, t_far.m)));  // std::min
+          miss = miss | Select(parallel, outside, t_near > t_far);
         }
-      }
+        const M4 hit = AndNot(lanes & has_axis, miss) & NotLessEqual(t_near, 1e-6f) &
+                       NotGreaterEqual(t_near, Load4(&out->t[i]));
+        if (!Bits(hit)) return;
+        // On a side face the normal is turned back by the yaw; on top or bottom it is +-z.
+        const M4 side = lz == zero;
+        on_hit(
+            i, hit, d, t_near,
+            V3{Select(side, cy * lx - sy * ly, zero), Select(side, sy * lx + cy * ly, zero), lz});
+      });
       return;
     }
-    for (int v = box.y; v < box.y + box.height; ++v) {
-      for (int u = box.x; u < box.x + box.width; ++u) {
-        const size_t i = static_cast<size_t>(v) * w + u;
-        const Vector3d d = (row_rays[v] + static_cast<float>(u) * ray_step).cast<double>();
+    if (p.kind == PrimitiveKind::kCylinder || p.kind == PrimitiveKind::kRing) {
+      // Cylinders and rings in double precision, two rays at a time.
+      for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
+        const __m128 t_old = _mm_loadu_ps(&out->t[i]);
+        const auto half = [&](int shift) SLAMO_ALWAYS_INLINE {
+          const auto wide = [&](__m128 x) SLAMO_ALWAYS_INLINE {
+            return D2(_mm_cvtps_pd(shift ? _mm_movehl_ps(x, x) : x));
+          };
+          return IntersectCylinder2(p, origin, wide(d.x.m), wide(d.y.m), wide(d.z.m), wide(t_old));
+        };
+        const Hit2 lo = half(0), hi = half(1);
+        const M4 hit = lanes & ToM4(lo.hit, hi.hit);
+        if (!Bits(hit)) return;
+        on_hit(i, hit, d, ToF4(lo.t, hi.t),
+               V3{ToF4(lo.nx, hi.nx), ToF4(lo.ny, hi.ny), ToF4(lo.nz, hi.nz)});
+      });
+      return;
+    }
+    // Everything else in double precision, one pixel at a time, shaded four at a time.
+    for_each_group([&](size_t i, M4 lanes, const V3& d) SLAMO_ALWAYS_INLINE {
+      alignas(16) float dx[4], dy[4], dz[4], t_lane[4], nx[4], ny[4], nz[4];
+      _mm_store_ps(dx, d.x.m), _mm_store_ps(dy, d.y.m), _mm_store_ps(dz, d.z.m);
+      const int valid = Bits(lanes);
+      alignas(16) int32_t hit_lane[4] = {0, 0, 0, 0};
+      for (int k = 0; k < 4; ++k) {
+        t_lane[k] = 0.0f, nx[k] = ny[k] = nz[k] = 0.0f;
+        if (!(valid >> k & 1)) continue;
+        const Vector3d dd = Vector3f(dx[k], dy[k], dz[k]).cast<double>();
         double t = 0.0;
         Vector3d n = Vector3d::Zero();
-        if (Intersect(p, origin, d, &t, &n) && t < out->t[i]) {
-          on_hit(i, d.cast<float>(), static_cast<float>(t), n.cast<float>());
+        if (Intersect(p, origin, dd, &t, &n) && t < out->t[i + k]) {
+          hit_lane[k] = -1;
+          t_lane[k] = static_cast<float>(t);
+          nx[k] = static_cast<float>(n.x()), ny[k] = static_cast<float>(n.y());
+          nz[k] = static_cast<float>(n.z());
         }
       }
+      const M4 hit{_mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(hit_lane)))};
+      if (!Bits(hit)) return;
+      on_hit(i, hit, d, F4(_mm_load_ps(t_lane)),
+             V3{F4(_mm_load_ps(nx)), F4(_mm_load_ps(ny)), F4(_mm_load_ps(nz))});
+    });
+  };
+  // Writes the hit lanes of four pixels: depth, id, colour and the no-depth flag; `behind`,
+  // when given, is what the colour buffer holds there.
+  const auto store = [&](size_t i, M4 hit, F4 t, int id, const V3& c, M4 no_depth,
+                         const V3* behind = nullptr) SLAMO_ALWAYS_INLINE {
+    const __m128i ids = _mm_set1_epi16(static_cast<int16_t>(static_cast<uint16_t>(id)));
+    __m128i* id_at = reinterpret_cast<__m128i*>(&out->id[i]);
+    // The flags as four bytes 0 or 1.
+    const __m128i flags16 = _mm_packs_epi32(_mm_castps_si128(no_depth.m), _mm_setzero_si128());
+    const __m128i flags8 =
+        _mm_and_si128(_mm_packs_epi16(flags16, _mm_setzero_si128()), _mm_set1_epi8(1));
+    if (Bits(hit) == 0xf) {  // all four: nothing to keep
+      _mm_storeu_ps(&out->t[i], t.m);
+      _mm_storel_epi64(id_at, ids);
+      StoreRgb4(&out->colour[i], c.x, c.y, c.z);
+      const int flags = _mm_cvtsi128_si32(flags8);
+      std::memcpy(&out->no_depth[i], &flags, 4);
+      return;
     }
+    _mm_storeu_ps(&out->t[i], Select(hit, t, Load4(&out->t[i])).m);
+    const __m128i hit16 = _mm_packs_epi32(_mm_castps_si128(hit.m), _mm_setzero_si128());
+    _mm_storel_epi64(id_at, _mm_or_si128(_mm_and_si128(hit16, ids),
+                                         _mm_andnot_si128(hit16, _mm_loadl_epi64(id_at))));
+    V3 old;
+    if (behind) {
+      old = *behind;
+    } else {
+      LoadRgb4(&out->colour[i], &old.x, &old.y, &old.z);
+    }
+    StoreRgb4(&out->colour[i], Select(hit, c.x, old.x), Select(hit, c.y, old.y),
+              Select(hit, c.z, old.z));
+    const __m128i hit8 = _mm_packs_epi16(hit16, _mm_setzero_si128());
+    int old_flags;
+    std::memcpy(&old_flags, &out->no_depth[i], 4);
+    const int flags = _mm_cvtsi128_si32(_mm_or_si128(
+        _mm_and_si128(hit8, flags8), _mm_andnot_si128(hit8, _mm_cvtsi32_si128(old_flags))));
+    std::memcpy(&out->no_depth[i], &flags, 4);
+  };
+  const V3 to_light{to_light_f.x(), to_light_f.y(), to_light_f.z()};
+  const F4 ambient4(ambient_f), diffuse4(diffuse_f);
+  // shade_f for four normals: albedo * tint * (ambient + diffuse * max(0, n . l)).
+  const auto shade4 = [&](const Vector3f& albedo_tint, const V3& n) SLAMO_ALWAYS_INLINE {
+    const F4 lambert = ambient4 + diffuse4 * MaxZero(Dot(n, to_light));
+    return V3{F4(albedo_tint.x()) * lambert, F4(albedo_tint.y()) * lambert,
+              F4(albedo_tint.z()) * lambert};
   };
   for (const Primitive& p : primitives) {
-    const Vector3f albedo = p.albedo.cast<float>();
-    const uint8_t black = Luminance(p.albedo) < options_.black_albedo ? 1 : 0;
-    for_each_hit(p, [&](size_t i, const Vector3f& d, float t, const Vector3f& n) {
-      out->t[i] = t;
-      out->id[i] = static_cast<uint16_t>(p.id);
-      Vector3f c = shade_f(albedo, n);
+    const Vector3f albedo_tint = p.albedo.cast<float>().cwiseProduct(tint_f);
+    const M4 black{
+        _mm_castsi128_ps(_mm_set1_epi32(Luminance(p.albedo) < options_.black_albedo ? -1 : 0))};
+    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) SLAMO_ALWAYS_INLINE {
+      V3 c = shade4(albedo_tint, n);
       if (p.glossy) {
         // Facing away from the half vector (n . h <= 0 before normalising), n . h / |h| is at
         // most a few 1e-7 and its 40th power is 0 in float: no highlight, as computed in full.
-        const Vector3f h = to_light_f - d.normalized();
-        if (n.dot(h) > 0.0f) {
-          c += Vector3f::Constant(0.25f * PowInt(std::max(0.0f, n.dot(h.normalized())), 40));
+        const V3 dn = Normalized(d);
+        const V3 h{to_light.x - dn.x, to_light.y - dn.y, to_light.z - dn.z};
+        const M4 facing = Dot(n, h) > F4(0.0f);
+        if (Bits(facing & hit)) {
+          const F4 highlight = F4(0.25f) * PowInt4(MaxZero(Dot(n, Normalized(h))), 40);
+          c = V3{Select(facing, c.x + highlight, c.x), Select(facing, c.y + highlight, c.y),
+                 Select(facing, c.z + highlight, c.z)};
         }
       }
-      out->colour[i] = c;
-      out->no_depth[i] = black;
+      store(i, hit, t, p.id, c, black);
     });
   }
 
@@ -764,46 +1140,65 @@ void SimRenderer::RenderPass(const SimWorld& world, const Eigen::Isometry3d& wor
     return (a.center - origin).squaredNorm() > (b.center - origin).squaredNorm();
   });
 
+  // spec > specular_dropout (a double) in float: above the largest float not above it.
+  float dropout = static_cast<float>(options_.specular_dropout);
+  if (static_cast<double>(dropout) > options_.specular_dropout) {
+    dropout = std::nextafter(dropout, -kInf);
+  }
+  const F4 dropout4(dropout);
   for (const Primitive& p : transparent) {
     const Vector3f tint = p.albedo.cast<float>();
-    const float opacity = static_cast<float>(p.opacity);
-    const Vector3f albedo = p.albedo.cast<float>();
-    for_each_hit(p, [&](size_t i, const Vector3f& d, float t, const Vector3f& n) {
-      const Vector3f view = -d.normalized();
+    const F4 opacity = static_cast<float>(p.opacity);
+    const F4 clear = 1.0f - static_cast<float>(p.opacity);
+    const Vector3f albedo_tint = p.albedo.cast<float>().cwiseProduct(tint_f);
+    const Vector3f filter = Vector3f::Constant(0.35f) + 0.65f * tint;
+    for_each_hit(p, [&](size_t i, M4 hit, const V3& d, F4 t, const V3& n) SLAMO_ALWAYS_INLINE {
+      const V3 dn = Normalized(d);
+      const V3 view{-dn.x, -dn.y, -dn.z};
       // Thin tinted plastic: the background shows through, filtered by the tint.
-      const Vector3f behind = out->colour[i].cwiseProduct(Vector3f::Constant(0.35f) + 0.65f * tint);
-      Vector3f c = opacity * shade_f(albedo, n) + (1.0f - opacity) * behind;
+      V3 behind;
+      LoadRgb4(&out->colour[i], &behind.x, &behind.y, &behind.z);
+      const V3 shaded = shade4(albedo_tint, n);
+      V3 c{opacity * shaded.x + clear * (behind.x * F4(filter.x())),
+           opacity * shaded.y + clear * (behind.y * F4(filter.y())),
+           opacity * shaded.z + clear * (behind.z * F4(filter.z()))};
       // Reflections: the ceiling lights as bright low-saturation patches, stronger at
       // grazing angles (Fresnel), plus the light's specular highlight.
-      const float n_dot_view = n.dot(view);
-      const Vector3f reflected = 2.0f * n_dot_view * n - view;
-      const float grazing = 1.0f - std::max(0.0f, n_dot_view);
-      const float fresnel = 0.1f + 0.9f * (grazing * grazing) * (grazing * grazing);
-      // Six ceiling light bands around the azimuth: sin(6 phi) from (x + iy)^6, no trig.
-      float ceiling = std::clamp((reflected.z() - 0.45f) / 0.25f, 0.0f, 1.0f);
-      if (ceiling > 0.0f) {
-        const float r2 = reflected.x() * reflected.x() + reflected.y() * reflected.y();
-        const std::complex<float> c1(reflected.x(), reflected.y());
-        const std::complex<float> c2 = c1 * c1;
-        ceiling *= 0.5f + 0.5f * (c2 * c2 * c2).imag() / (r2 * r2 * r2);
+      const F4 n_dot_view = Dot(n, view);
+      const F4 twice = F4(2.0f) * n_dot_view;
+      const V3 reflected{twice * n.x - view.x, twice * n.y - view.y, twice * n.z - view.z};
+      const F4 grazing = F4(1.0f) - MaxZero(n_dot_view);
+      const F4 fresnel = F4(0.1f) + F4(0.9f) * (grazing * grazing) * (grazing * grazing);
+      // Six ceiling light bands around the azimuth: sin(6 phi) from (x + iy)^6, no trig (the
+      // products std::complex<float> takes: re = ac - bd, im = ad + bc).
+      const F4 q = (reflected.z - 0.45f) / 0.25f;
+      F4 ceiling = Select(q < F4(0.0f), 0.0f, Select(F4(1.0f) < q, 1.0f, q));  // std::clamp
+      const M4 lit = ceiling > F4(0.0f);
+      if (Bits(lit & hit)) {
+        const F4 rx = reflected.x, ry = reflected.y;
+        const F4 r2 = rx * rx + ry * ry;
+        const F4 c2_re = rx * rx - ry * ry, c2_im = rx * ry + ry * rx;
+        const F4 c4_re = c2_re * c2_re - c2_im * c2_im, c4_im = c2_re * c2_im + c2_im * c2_re;
+        const F4 c6_im = c4_re * c2_im + c4_im * c2_re;
+        ceiling = Select(lit, ceiling * (F4(0.5f) + F4(0.5f) * c6_im / (r2 * r2 * r2)), ceiling);
       }
-      const float patch = std::min(1.0f, fresnel * 0.6f + 0.7f * ceiling);
+      const F4 patch = MinOne(fresnel * 0.6f + F4(0.7f) * ceiling);
       // As for glossy solids: n . h <= 0 before normalising means a highlight of exactly 0.
-      const Vector3f h = view + to_light_f;
-      const float spec =
-          n.dot(h) > 0.0f ? 0.9f * PowInt(std::max(0.0f, n.dot(h.normalized())), 60) : 0.0f;
-      c = (1.0f - patch) * c + patch * Vector3f::Constant(0.85f);
-      c += Vector3f::Constant(spec);
-      out->colour[i] = c;
-      out->t[i] = t;
-      out->id[i] = static_cast<uint16_t>(p.id);
-      out->no_depth[i] = spec > options_.specular_dropout ? 1 : 0;
+      const V3 h{view.x + to_light.x, view.y + to_light.y, view.z + to_light.z};
+      const M4 facing = Dot(n, h) > F4(0.0f);
+      F4 spec = 0.0f;
+      if (Bits(facing & hit)) {
+        spec = Select(facing, F4(0.9f) * PowInt4(MaxZero(Dot(n, Normalized(h))), 60), 0.0f);
+      }
+      const F4 keep = F4(1.0f) - patch, glare = patch * F4(0.85f);
+      c = V3{keep * c.x + glare + spec, keep * c.y + glare + spec, keep * c.z + glare + spec};
+      store(i, hit, t, p.id, c, spec > dropout4, &behind);
     });
   }
 }
 
-RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double t_s,
-                              FrameTruth* truth) {
+SLAMO_AVX_CLONES RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot,
+                                               double t_s, FrameTruth* truth) {
   const int w = camera_.width_px;
   const int h = camera_.height_px;
   const Eigen::Isometry3d world_from_camera = CameraPose(robot);
@@ -836,18 +1231,27 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
   const float* colour_noise = normal_pool_.data() + offset(rng_);
   const float* depth_noise = normal_pool_.data() + offset(rng_);
 
-  // Colour: 255 * linear RGB + sigma * N(0, 1), to 8-bit BGR, with OpenCV's vector code.
-  const cv::Mat colour_f(h, w, CV_32FC3, const_cast<Vector3f*>(colour_pass->colour.data()));
-  cv::Mat scaled;
-  if (options_.colour_noise) {
-    const cv::Mat noise(h, w, CV_32FC3, const_cast<float*>(colour_noise));
-    cv::scaleAdd(noise, options_.colour_noise_sigma / 255.0, colour_f, scaled);
-  } else {
-    scaled = colour_f;
+  // Colour: 255 * linear RGB + sigma * N(0, 1), to 8-bit BGR, with OpenCV's vector code, a
+  // band of pixels at a time so the intermediate images stay in cache. Each band starts a
+  // multiple of 64 floats into the image, so every element goes through the same code
+  // (vector body or tail) as when the whole image was converted at once.
+  constexpr size_t kBand = 4096;  // pixels
+  const float* colour_all = colour_pass->colour.data()->data();
+  uint8_t* bgr = frame.colour.ptr<uint8_t>(0);
+  cv::Mat scaled, rgb8;
+  for (size_t p0 = 0; p0 < n; p0 += kBand) {
+    const int count = static_cast<int>(std::min(kBand, n - p0));
+    const cv::Mat colour_f(1, count, CV_32FC3, const_cast<float*>(colour_all + 3 * p0));
+    if (options_.colour_noise) {
+      const cv::Mat noise(1, count, CV_32FC3, const_cast<float*>(colour_noise + 3 * p0));
+      cv::scaleAdd(noise, options_.colour_noise_sigma / 255.0, colour_f, scaled);
+    } else {
+      scaled = colour_f;
+    }
+    scaled.convertTo(rgb8, CV_8UC3, 255.0);
+    cv::Mat bgr_band(1, count, CV_8UC3, bgr + 3 * p0);
+    cv::cvtColor(rgb8, bgr_band, cv::COLOR_RGB2BGR);
   }
-  cv::Mat rgb8;
-  scaled.convertTo(rgb8, CV_8UC3, 255.0);
-  cv::cvtColor(rgb8, frame.colour, cv::COLOR_RGB2BGR);
 
   // Depth: the camera's linear error, then sigma(d) noise, in whole millimetres.
   const float a = static_cast<float>(options_.depth_bias ? camera_.depth_correction.a : 1.0);
@@ -856,19 +1260,54 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
   const float max_range = static_cast<float>(camera_.max_range_m);
   const size_t sigma_last = sigma_mm_by_mm_.size() - 1;
   uint16_t* depth_out = frame.depth_mm.ptr<uint16_t>(0);
-  for (size_t i = 0; i < n; ++i) {
+  const auto depth_at = [&](size_t i) -> uint16_t {
     const float z = depth_pass.t[i];
-    uint16_t depth = 0;
-    if (!depth_pass.no_depth[i] && z >= min_range && z <= max_range) {  // false for inf
-      float measured_mm = a * z * 1000.0f + b_mm;
-      if (options_.depth_noise) {
-        measured_mm += sigma_mm_by_mm_[std::min(sigma_last, static_cast<size_t>(z * 1000.0f))] *
-                       depth_noise[i];
-      }
-      depth = static_cast<uint16_t>(std::clamp(measured_mm + 0.5f, 0.0f, 65535.0f));
+    if (depth_pass.no_depth[i] || !(z >= min_range && z <= max_range)) return 0;  // inf too
+    float measured_mm = a * z * 1000.0f + b_mm;
+    if (options_.depth_noise) {
+      measured_mm +=
+          sigma_mm_by_mm_[std::min(sigma_last, static_cast<size_t>(z * 1000.0f))] * depth_noise[i];
     }
-    depth_out[i] = depth;
+    return static_cast<uint16_t>(std::clamp(measured_mm + 0.5f, 0.0f, 65535.0f));
+  };
+  // Four pixels at a time, the same float operations as depth_at; sigma(d) looked up per lane.
+  const F4 a4(a), b4(b_mm), mm(1000.0f), near4(min_range), far4(max_range), top(65535.0f);
+  const __m128i last = _mm_set1_epi32(static_cast<int>(sigma_last));
+  size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    const F4 z = Load4(&depth_pass.t[i]);
+    int flags;
+    std::memcpy(&flags, &depth_pass.no_depth[i], 4);
+    const __m128i flags32 = _mm_unpacklo_epi16(
+        _mm_unpacklo_epi8(_mm_cvtsi32_si128(flags), _mm_setzero_si128()), _mm_setzero_si128());
+    const M4 reads = M4{_mm_castsi128_ps(_mm_cmpeq_epi32(flags32, _mm_setzero_si128()))} &
+                     (z >= near4) & (z <= far4);
+    if (!Bits(reads)) {
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(depth_out + i), _mm_setzero_si128());
+      continue;
+    }
+    F4 measured_mm = a4 * z * mm + b4;
+    if (options_.depth_noise) {
+      // The table index as static_cast<size_t>, within the table (0 where nothing is read).
+      __m128i index = _mm_and_si128(_mm_cvttps_epi32((z * mm).m), _mm_castps_si128(reads.m));
+      const __m128i over = _mm_cmpgt_epi32(index, last);
+      index = _mm_or_si128(_mm_and_si128(over, last), _mm_andnot_si128(over, index));
+      alignas(16) int32_t k[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(k), index);
+      const F4 sigma(_mm_setr_ps(sigma_mm_by_mm_[k[0]], sigma_mm_by_mm_[k[1]],
+                                 sigma_mm_by_mm_[k[2]], sigma_mm_by_mm_[k[3]]));
+      measured_mm = measured_mm + sigma * Load4(depth_noise + i);
+    }
+    const F4 x = measured_mm + 0.5f;
+    const F4 clamped = Select(x < F4(0.0f), 0.0f, Select(top < x, top, x));  // std::clamp
+    // To uint16 by truncation; biased by 2^15 for SSE2's signed 16-bit pack.
+    const __m128i depth = _mm_and_si128(_mm_cvttps_epi32(clamped.m), _mm_castps_si128(reads.m));
+    const __m128i packed = _mm_xor_si128(
+        _mm_packs_epi32(_mm_sub_epi32(depth, _mm_set1_epi32(32768)), _mm_setzero_si128()),
+        _mm_set1_epi16(static_cast<int16_t>(0x8000)));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(depth_out + i), packed);
   }
+  for (; i < n; ++i) depth_out[i] = depth_at(i);
 
   if (truth) {
     truth->robot = robot;
@@ -883,17 +1322,35 @@ RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose2D& robot, double
       int u0 = 0, v0 = 0, u1 = 0, v1 = 0;
     };
     std::vector<Extent> extents(kLandmarkIdBase + season_.landmarks.size());
+    // A row at a time in runs of one id (found eight ids at a time): a run adds its length
+    // and widens the box to its ends, as its pixels one by one would.
     for (int v = 0; v < h; ++v) {
       const uint16_t* row = depth_pass.id.data() + static_cast<size_t>(v) * w;
-      for (int u = 0; u < w; ++u) {
+      for (int u = 0; u < w;) {
         const uint16_t id = row[u];
-        if (id == 0 || id >= extents.size()) continue;
-        Extent& e = extents[id];
-        if (e.count++ == 0) {
-          e.u0 = e.u1 = u, e.v0 = e.v1 = v;
-        } else {
-          e.u0 = std::min(e.u0, u), e.u1 = std::max(e.u1, u), e.v1 = v;  // rows come in order
+        const __m128i same = _mm_set1_epi16(static_cast<int16_t>(id));
+        int end = u + 1;
+        for (; end + 8 <= w; end += 8) {
+          const __m128i ids = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + end));
+          const int equal = _mm_movemask_epi8(_mm_cmpeq_epi16(ids, same));
+          if (equal != 0xffff) {
+            end += __builtin_ctz(~equal) / 2;
+            break;
+          }
         }
+        if (end + 8 > w) {
+          while (end < w && row[end] == id) ++end;
+        }
+        if (id != 0 && id < extents.size()) {
+          Extent& e = extents[id];
+          if (e.count == 0) {
+            e.u0 = u, e.u1 = end - 1, e.v0 = e.v1 = v;
+          } else {
+            e.u0 = std::min(e.u0, u), e.u1 = std::max(e.u1, end - 1), e.v1 = v;  // rows in order
+          }
+          e.count += end - u;
+        }
+        u = end;
       }
     }
     const auto box_of = [&](int id) {
