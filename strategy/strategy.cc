@@ -48,9 +48,11 @@ struct Cycle {
   double gain = 0.0;         // points after - points before
   double probability = 0.0;  // of the pick and the release both succeeding
   int frames = 0;            // observed first
-  // A knock: drive to pick_stage, then push straight on to score_stage; the object drops into
-  // goal (a zone). Nothing is held before or after.
+  // A knock: drive to pick_stage, push straight on to push_end and back to pick_stage
+  // (score_stage, where the next cycle starts); the object drops into goal (a zone). Nothing is
+  // held before or after.
   bool knock = false;
+  Eigen::Vector3d push_end = Eigen::Vector3d::Zero();
   double Value() const { return probability * gain; }
 };
 
@@ -59,6 +61,14 @@ struct Cycle {
 class Base : public Strategy {
  public:
   explicit Base(const StrategyOptions& options) : options_(options) {}
+
+  Action Next(const Belief& b, const StrategyContext& c) final {
+    LearnDuration(b);
+    Action a = Choose(b, c);
+    pending_ = a;
+    pending_start_s_ = b.now_s;
+    return a;
+  }
 
   void Feedback(const Action& action, bool succeeded) override {
     // A push is not repeated: the object either came down or is not where it was believed.
@@ -71,6 +81,36 @@ class Base : public Strategy {
   }
 
  protected:
+  virtual Action Choose(const Belief& b, const StrategyContext& c) = 0;
+
+  // How long drives, picks and releases really take against the estimates (turns, stops to
+  // look, arrival fixes, backing off a goal are not all in them), learned during the match:
+  // the mean ratio of the time taken to the estimate, with a prior of 1 worth
+  // kDurationPriorWeight actions. Cycles are timed with the estimates scaled by it, so that a
+  // robot slower than its model does not start sequences it cannot finish.
+  enum DurationClass { kDrive = 0, kPickClass = 1, kReleaseClass = 2 };
+  static constexpr double kDurationPriorWeight = 2.0;
+  double Scale(DurationClass k) const {
+    if (!options_.learn_durations) return 1.0;
+    return (kDurationPriorWeight + ratio_sum_[k]) / (kDurationPriorWeight + ratio_count_[k]);
+  }
+  void LearnDuration(const Belief& b) {
+    if (!pending_) return;
+    const Action a = *pending_;
+    pending_.reset();
+    // Cut short by the deadline, refused (no time passed), or too short to say anything: not
+    // learned from.
+    if (a.expected_s < 0.5 || b.now_s >= b.deadline_s - 1e-6 || b.now_s <= pending_start_s_ + 1e-6)
+      return;
+    int k = -1;
+    if (a.kind == ActionKind::kNavigate) k = kDrive;
+    if (a.kind == ActionKind::kPick) k = kPickClass;
+    if (a.kind == ActionKind::kScore) k = kReleaseClass;
+    if (k < 0) return;
+    ratio_sum_[k] += std::clamp((b.now_s - pending_start_s_) / a.expected_s, 0.5, 3.0);
+    ratio_count_[k] += 1.0;
+  }
+
   // A look is not repeated towards the same 30-degree sector from the same half-metre cell.
   static long LookKey(const Eigen::Vector3d& pose, double heading) {
     return (std::lround(pose.x() * 2.0) * 100 + std::lround(pose.y() * 2.0)) * 100 +
@@ -130,14 +170,15 @@ class Base : public Strategy {
   }
 
   // Whether the final straight approach from `stage` over `length_m` is free of known
-  // objects (other than `except`): an object pinned between the bumper and a goal stops the
-  // robot short, so such approaches are not offered.
+  // objects (other than `except`, and those smaller than min_size_m): an object pinned between
+  // the bumper and a goal stops the robot short, so such approaches are not offered.
   static bool CorridorFree(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& stage,
-                           double length_m, int except) {
+                           double length_m, int except, double min_size_m = 0.0) {
     const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
     for (const ObjectBelief& o : b.objects) {
       if (o.id == except) continue;
       const double r = ObjectRadius(*c.season, o.kind);
+      if (2.0 * r < min_size_m) continue;
       const Eigen::Vector2d rel = o.position_m - stage.head<2>();
       const double along = rel.dot(dir);
       const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
@@ -168,12 +209,17 @@ class Base : public Strategy {
       auto failed = failed_goals_.find(g);
       if (failed != failed_goals_.end() && failed->second >= 2) continue;
       GoalChoice best;
+      // Into a floor zone, an object narrower than the robot on the way is pushed along and the
+      // release still lands in the zone: only wider ones block the approach.
+      const double blocking =
+          c.season->goals[g].kind == field::GoalKind::kZone ? c.robot->width_m : 0.0;
       for (const Eigen::Vector3d& stage : ScoreStages(c, g, r, options_.approach_margin_m)) {
         if (failed_targets_.count(Key(stage))) continue;
-        if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except)) continue;
+        if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except, blocking)) continue;
         const std::optional<double> t = c.travel_time_s(from, stage);
         if (!t) continue;
-        const double seconds = *t + ApproachSeconds(c) + options_.release_s;
+        const double seconds =
+            *t * Scale(kDrive) + (ApproachSeconds(c) + options_.release_s) * Scale(kReleaseClass);
         if (best.goal < 0 || seconds < best.seconds) best = {g, stage, seconds, points};
       }
       if (best.goal >= 0) out.push_back(best);
@@ -205,9 +251,10 @@ class Base : public Strategy {
   }
 
   // Knocking an object off the raised structure it lies on: for each way across the structure
-  // (a box's thin axis), the robot drives straight at it and stops where it can still turn in
-  // place (pressed against the structure it could not turn away); its bumper has pushed the
-  // object on by its radius, and the object drops where it then stands.
+  // (a box's thin axis), the robot drives straight at it until its bumper is kKnockGap_m short
+  // of the structure (or of anything else fixed); its bumper has pushed the object on by its
+  // radius, and the object drops where it then stands. (Pressed that close the robot cannot
+  // turn in place: the next drive backs out first, MatchWorld::Navigate.)
   std::vector<Cycle> KnockCycles(const Belief& b, const StrategyContext& c, const ObjectBelief& o,
                                  const field::Structure& s, const Eigen::Vector3d& from,
                                  int frames) const {
@@ -216,15 +263,18 @@ class Base : public Strategy {
     const double r = ObjectRadius(*c.season, o.kind);
     const double yaw = s.yaw_deg * kPi / 180.0 + (s.size_m.x <= s.size_m.y ? 0.0 : kPi / 2.0);
     const double half = c.season->HalfSize();
+    constexpr double kKnockGap_m = 0.02;
     for (const double sign : {1.0, -1.0}) {
       const Eigen::Vector2d dir = sign * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
-      const double turn_radius = std::hypot(c.robot->length_m, c.robot->width_m) / 2.0 + 0.02;
+      const double heading_rad = std::atan2(dir.y(), dir.x());
+      const double reach = std::hypot(c.robot->length_m, c.robot->width_m) / 2.0 + kKnockGap_m;
       std::optional<Eigen::Vector2d> end;
-      for (double back = 0.0; back <= 1.0 && !end; back += 0.02) {
+      for (double back = 0.0; back <= 1.0 && !end; back += 0.01) {
         const Eigen::Vector2d p = o.position_m - back * dir;
-        if (c.is_clear(p) && std::abs(p.x()) < half - turn_radius &&
-            std::abs(p.y()) < half - turn_radius &&
-            !platform::PointInBlockingStructure(*c.season, p, turn_radius, c.robot->height_m)) {
+        if (std::abs(p.x()) < half - reach && std::abs(p.y()) < half - reach &&
+            platform::FootprintIsFree(*c.season, platform::Pose2D{p.x(), p.y(), heading_rad},
+                                      c.robot->length_m + 2.0 * kKnockGap_m,
+                                      c.robot->width_m + 2.0 * kKnockGap_m, c.robot->height_m)) {
           end = p;
         }
       }
@@ -246,7 +296,7 @@ class Base : public Strategy {
         if (p > points) goal = g, points = p;
       }
       if (goal < 0) continue;
-      const double heading = std::atan2(dir.y(), dir.x());
+      const double heading = heading_rad;
       const Eigen::Vector2d stage = *end - options_.push_run_in_m * dir;
       if (!c.is_clear(stage)) continue;
       const Eigen::Vector3d stage_pose(stage.x(), stage.y(), heading);
@@ -257,9 +307,10 @@ class Base : public Strategy {
       cycle.object = &o;
       cycle.knock = true;
       cycle.pick_stage = stage_pose;
-      cycle.score_stage = Eigen::Vector3d(end->x(), end->y(), heading);
+      cycle.push_end = Eigen::Vector3d(end->x(), end->y(), heading);
+      cycle.score_stage = stage_pose;
       cycle.goal = goal;
-      cycle.seconds = *t + PushSeconds(c) + frames / c.frame_rate_hz;
+      cycle.seconds = (*t + PushSeconds(c)) * Scale(kDrive) + frames / c.frame_rate_hz;
       cycle.gain = points;  // on top of a structure it lies in no zone
       // Straight off when the bumper meets it within half its width of its centre.
       const double pose_var = PoseVarianceAfter(b, frames);
@@ -272,8 +323,10 @@ class Base : public Strategy {
     return out;
   }
 
+  // The run-in, and back out the same way (pressed against the structure the robot could not
+  // turn, and the way it came is clear).
   double PushSeconds(const StrategyContext& c) const {
-    return options_.push_run_in_m / c.robot->drive.cruise_speed_mps + 0.5;
+    return 2.0 * options_.push_run_in_m / c.robot->drive.cruise_speed_mps + 1.0;
   }
 
   // Cycles for one object from `from`: pick it, then each goal that takes it; or knock it off
@@ -297,7 +350,8 @@ class Base : public Strategy {
     if (!stage || failed_targets_.count(Key(*stage))) return out;
     const std::optional<double> t = c.travel_time_s(from, *stage);
     if (!t) return out;
-    const double pick_s = *t + ApproachSeconds(c) + options_.pick_s;
+    const double pick_s =
+        *t * Scale(kDrive) + (ApproachSeconds(c) + options_.pick_s) * Scale(kPickClass);
     const double before = FloorPoints(*c.season, o.position_m, o.kind, o.colour, c.alliance);
     const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
     const Eigen::Vector3d picked_at(o.position_m.x() - dir.x() * PickDistance(*c.robot, r),
@@ -360,6 +414,9 @@ class Base : public Strategy {
     if (cycle.knock) {
       a.kind = ActionKind::kNavigate;
       a.object_id = cycle.object->id;
+      a.object_kind = cycle.object->kind;
+      a.object_colour = cycle.object->colour;
+      a.object_m = cycle.object->position_m;
       a.goal_index = cycle.goal;
       const std::string what =
           cycle.object->colour + " " + cycle.object->kind + " #" + std::to_string(cycle.object->id);
@@ -369,7 +426,7 @@ class Base : public Strategy {
         a.why = "to knock " + what + " off";
       } else {
         a.push = true;
-        a.target = cycle.score_stage;
+        a.target = cycle.push_end;
         a.expected_s = PushSeconds(c);
         a.why = "knock " + what + " into " + c.season->goals[cycle.goal].name;
       }
@@ -496,6 +553,47 @@ class Base : public Strategy {
     return a;
   }
 
+  // The belief with the season's raised objects added: an object the season file places on a
+  // raised structure (a large ball on the Toss Up barrier) stays there until something knocks
+  // it off, so its spot is known to the placement accuracy without seeing it, and a knock
+  // forgives half the robot's width. Seen from the floor such an object is often believed
+  // tenths of a metre off its spot (then off the structure, and offered as a pick the intake
+  // cannot make): a tracked object of the same kind and colour within kPriorMatch_m of an
+  // unknocked spot is that object and gives way to it. Ids -1000 - k (k: the placement's
+  // index), never a tracked object's.
+  std::vector<ObjectBelief> WithRaisedPriors(const Belief& b, const StrategyContext& c) const {
+    constexpr double kPriorMatch_m = 0.5;
+    std::vector<ObjectBelief> priors;
+    for (size_t k = 0; k < c.season->objects.size(); ++k) {
+      const field::ObjectPlacement& p = c.season->objects[k];
+      if (!p.position_m || p.z_m <= 0.0 || p.stack_level > 0) continue;
+      const Eigen::Vector2d at(p.position_m->x, p.position_m->y);
+      if (!RaisedOn(*c.season, p.type, at)) continue;
+      ObjectBelief o;
+      o.id = -1000 - static_cast<int>(k);
+      o.kind = p.type;
+      o.colour = p.colour;
+      o.position_m = at;
+      o.covariance = Eigen::Matrix2d::Identity() * options_.prior_sigma_m * options_.prior_sigma_m;
+      priors.push_back(o);
+    }
+    // A spot already knocked: what is still believed on the structure near it is the same
+    // object (a push is not repeated); what is believed on the floor may be picked.
+    std::vector<ObjectBelief> out;
+    for (const ObjectBelief& o : b.objects) {
+      const bool seen_prior = std::any_of(priors.begin(), priors.end(), [&](const ObjectBelief& p) {
+        return p.kind == o.kind && p.colour == o.colour &&
+               (p.position_m - o.position_m).norm() < kPriorMatch_m &&
+               (!knocked_.count(p.id) || RaisedOn(*c.season, o.kind, o.position_m));
+      });
+      if (!seen_prior) out.push_back(o);
+    }
+    for (const ObjectBelief& p : priors) {
+      if (!knocked_.count(p.id)) out.push_back(p);
+    }
+    return out;
+  }
+
   StrategyOptions options_;
   std::map<int, int> failed_objects_;
   std::map<int, int> failed_goals_;
@@ -503,6 +601,10 @@ class Base : public Strategy {
   std::map<long, int> looked_;
   std::set<int> knocked_;
   bool surveyed_ = false;
+  std::optional<Action> pending_;  // the last action chosen, and when
+  double pending_start_s_ = 0.0;
+  double ratio_sum_[3] = {0.0, 0.0, 0.0};
+  double ratio_count_[3] = {0.0, 0.0, 0.0};
 };
 
 // Our method: the receding-horizon search described in strategy.h.
@@ -511,7 +613,9 @@ class PlannerStrategy : public Base {
   using Base::Base;
   std::string name() const override { return "planner"; }
 
-  Action Next(const Belief& b, const StrategyContext& c) override {
+  Action Choose(const Belief& observed, const StrategyContext& c) override {
+    Belief b = observed;
+    if (options_.raised_priors) b.objects = WithRaisedPriors(observed, c);
     const double left = b.deadline_s - b.now_s;
     if (!surveyed_) {  // the initial survey: nothing is known before the first frames
       surveyed_ = true;
@@ -586,7 +690,7 @@ class GreedyStrategy : public Base {
       : Base(options), name_(std::move(name)), spacing_(spacing), frames_(frames) {}
   std::string name() const override { return name_; }
 
-  Action Next(const Belief& b, const StrategyContext& c) override {
+  Action Choose(const Belief& b, const StrategyContext& c) override {
     if (!surveyed_) {
       surveyed_ = true;
       Action a;
@@ -652,7 +756,7 @@ class ScriptedStrategy : public Base {
   std::string name() const override { return "scripted"; }
   bool perceives() const override { return false; }
 
-  Action Next(const Belief& b, const StrategyContext& c) override {
+  Action Choose(const Belief& b, const StrategyContext& c) override {
     if (!planned_) Plan(b, c);
     if (next_ >= route_.size()) {
       Action idle;
@@ -755,11 +859,14 @@ class ScriptedStrategy : public Base {
       const ObjectBelief& o = nominal_[index];
       nav.target = cycle.pick_stage;
       nav.object_id = o.id;
+      nav.object_kind = o.kind;
+      nav.object_colour = o.colour;
+      nav.object_m = o.position_m;
       nav.why = "script: to knock nominal " + o.colour + " " + o.kind + " off";
       route_.push_back(nav);
       Action push = nav;
       push.push = true;
-      push.target = cycle.score_stage;
+      push.target = cycle.push_end;
       push.goal_index = cycle.goal;
       push.expected_s = PushSeconds(c);
       push.why = "script: knock it into " + c.season->goals[cycle.goal].name;

@@ -81,7 +81,9 @@ struct Action {
   // kNavigate: a push, driven straight into object_id to knock it off the raised structure it
   // lies on (a large ball off the Toss Up barrier) into the zone beyond.
   bool push = false;
-  int object_id = -1;  // kPick
+  int object_id = -1;  // kPick; kNavigate with push: the object knocked
+  // kNavigate with push: where the object is believed to lie (for the record only).
+  Eigen::Vector2d object_m = Eigen::Vector2d::Zero();
   // kPick: the target's kind and colour (also where object_id names no tracked object: the
   // scripted route's nominal objects). For the record only: the executive takes what the
   // intake reports.
@@ -112,6 +114,14 @@ struct StrategyOptions {
   std::function<std::optional<double>(const std::string& action, const std::string& kind,
                                       double range_m, double bearing_rad, double sigma_m)>
       learned_success;
+  // Planner: objects the season file places on a raised structure (the Toss Up barrier's large
+  // balls) are believed at their spot, with this position sigma, until knocked off (see
+  // strategy.cc, RaisedPriors). Not measured: the field facts give no placement tolerance.
+  bool raised_priors = true;
+  // Time cycles with the drive, pick and release estimates scaled by how long those actions
+  // took so far in the match (strategy.cc, Base::Scale).
+  bool learn_durations = true;
+  double prior_sigma_m = 0.05;
   double min_gain = 0.25;         // expected points below this are not worth a cycle
   int look_frames = 10;           // frames of an exploratory look
   int arrival_frames = 5;         // planner: frames to check an arrival

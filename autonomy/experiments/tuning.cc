@@ -319,7 +319,7 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
     s.combo = combo;
     std::vector<double> points, gained;
     int updates = 0, honest = 0, attempts = 0, inside = 0;
-    int pick_target = 0, pick_other = 0, pick_nothing = 0, scored = 0;
+    int pick_target = 0, pick_other = 0, pick_nothing = 0, scored = 0, knocked = 0;
     for (const MatchOutcome* o : by_combo[combo]) {
       if (o->failed) {
         ++s.failed;
@@ -342,6 +342,9 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
         } else if (a.action == "SCORE") {
           ++s.releases;
           scored += a.outcome == "scored";
+        } else if (a.action == "KNOCK") {
+          ++s.knocks;
+          knocked += a.outcome == "scored";
         }
       }
       s.mean_wall_s += o->wall_s;
@@ -364,6 +367,7 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
     s.pick_other_fraction = fraction(pick_other, s.picks);
     s.pick_nothing_fraction = fraction(pick_nothing, s.picks);
     s.release_scored_fraction = fraction(scored, s.releases);
+    s.knock_scored_fraction = fraction(knocked, s.knocks);
     mean_ci(points, &s.mean_points, &s.ci95_points);
     mean_ci(gained, &s.mean_gained, &s.ci95_gained);
     if (s.matches > 0) {
@@ -384,7 +388,8 @@ std::string SummaryCsv(const std::vector<ComboSummary>& rows) {
   out << "rank,combo,matches,failed,mean_points,ci95_points,mean_gained,ci95_gained,overruns,mean_"
          "overrun_s,"
          "mean_ate_m,nees_honest_fraction,attempts_inside_fraction,picks,pick_target_fraction,"
-         "pick_other_fraction,pick_nothing_fraction,releases,release_scored_fraction,mean_wall_s\n";
+         "pick_other_fraction,pick_nothing_fraction,releases,release_scored_fraction,knocks,"
+         "knock_scored_fraction,mean_wall_s\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
     out << ++rank << ",\"" << r.combo << "\"," << r.matches << ',' << r.failed << ','
@@ -392,7 +397,8 @@ std::string SummaryCsv(const std::vector<ComboSummary>& rows) {
         << ',' << r.overruns << ',' << r.mean_overrun_s << ',' << r.mean_ate_m << ','
         << r.nees_honest_fraction << ',' << r.attempts_inside_fraction << ',' << r.picks << ','
         << r.pick_target_fraction << ',' << r.pick_other_fraction << ',' << r.pick_nothing_fraction
-        << ',' << r.releases << ',' << r.release_scored_fraction << ',' << r.mean_wall_s << '\n';
+        << ',' << r.releases << ',' << r.release_scored_fraction << ',' << r.knocks << ','
+        << r.knock_scored_fraction << ',' << r.mean_wall_s << '\n';
   }
   return out.str();
 }
@@ -418,6 +424,8 @@ nlohmann::json SummaryJson(const std::vector<ComboSummary>& rows,
                             {"pick_target_fraction", r.pick_target_fraction},
                             {"pick_other_fraction", r.pick_other_fraction},
                             {"pick_nothing_fraction", r.pick_nothing_fraction},
+                            {"knocks", r.knocks},
+                            {"knock_scored_fraction", r.knock_scored_fraction},
                             {"releases", r.releases},
                             {"release_scored_fraction", r.release_scored_fraction},
                             {"mean_wall_s", r.mean_wall_s}});
@@ -433,7 +441,8 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
       << "gained (95% CI)" << std::setw(10) << "overruns" << std::setw(10) << "ATE m"
       << std::setw(10) << "NEES ok" << std::setw(10) << "in 3sig" << std::setw(7) << "picks"
       << std::setw(8) << "target" << std::setw(8) << "other" << std::setw(8) << "nothing"
-      << std::setw(7) << "rels" << std::setw(8) << "scored" << std::setw(10) << "wall s"
+      << std::setw(7) << "rels" << std::setw(8) << "scored" << std::setw(8) << "knocks"
+      << std::setw(8) << "down" << std::setw(10) << "wall s"
       << "\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
@@ -447,8 +456,8 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
         << r.nees_honest_fraction << std::setw(10) << r.attempts_inside_fraction << std::setw(7)
         << r.picks << std::setprecision(2) << std::setw(8) << r.pick_target_fraction << std::setw(8)
         << r.pick_other_fraction << std::setw(8) << r.pick_nothing_fraction << std::setw(7)
-        << r.releases << std::setw(8) << r.release_scored_fraction << std::setw(10) << r.mean_wall_s
-        << "\n";
+        << r.releases << std::setw(8) << r.release_scored_fraction << std::setw(8) << r.knocks
+        << std::setw(8) << r.knock_scored_fraction << std::setw(10) << r.mean_wall_s << "\n";
     if (r.failed) out << "     (" << r.failed << " matches failed: see tune.json)\n";
   }
 }

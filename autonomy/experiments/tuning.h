@@ -86,6 +86,10 @@ struct ComboSummary {
   int picks = 0, releases = 0;
   double pick_target_fraction = 0.0, pick_other_fraction = 0.0, pick_nothing_fraction = 0.0;
   double release_scored_fraction = 0.0;
+  // Knocks off a raised structure, and the fraction that brought the object down into the
+  // zone aimed at.
+  int knocks = 0;
+  double knock_scored_fraction = 0.0;
   double mean_wall_s = 0.0;
 };
 // Per combination, ranked by mean points (best first).

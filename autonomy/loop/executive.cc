@@ -15,12 +15,16 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "platform/field_geometry.h"
 #include "strategy/strategy.h"
 
 namespace slamo::autonomy {
 namespace {
 
 using strategy::ActionKind;
+
+// Up on a structure (the Toss Up barrier), not resting on the floor.
+bool Raised(const TrueObject& t) { return t.center_m.z() > t.radius_m + 0.05; }
 
 // The robot's true position error and the filter's 3-sigma now, and what `action` aims at
 // from where; none without the truth.
@@ -42,7 +46,19 @@ std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const strategy
           0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position).eigenvalues().maxCoeff()));
 
   Eigen::Vector2d aim = action.target.head<2>();
-  if (action.kind == ActionKind::kPick) {
+  if (action.kind == ActionKind::kNavigate && action.push) {
+    c.action = "KNOCK";
+    c.kind = action.object_kind, c.colour = action.object_colour;
+    c.goal_index = action.goal_index;
+    aim = action.object_m;
+    double best = kTargetMatch_m;
+    for (const TrueObject& t : *objects) {
+      if (t.held || t.in_goal >= 0 || !Raised(t)) continue;
+      if (!c.kind.empty() && (t.kind != c.kind || t.colour != c.colour)) continue;
+      const double e = (t.center_m.head<2>() - aim).norm();
+      if (e < best) best = e, c.target_truth_id = t.id, c.target_error_m = e;
+    }
+  } else if (action.kind == ActionKind::kPick) {
     c.kind = action.object_kind, c.colour = action.object_colour;
     for (const strategy::ObjectBelief& o : belief.objects) {
       if (o.id == action.object_id) aim = o.position_m, c.kind = o.kind, c.colour = o.colour;
@@ -72,8 +88,19 @@ std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const strategy
 }
 
 // What came of the attempt, from the simulator's objects before and after it.
-void JudgeAttempt(const std::vector<TrueObject>& before, const std::vector<TrueObject>& after,
-                  AttemptCheck* c) {
+void JudgeAttempt(const field::SeasonConfig& season, const std::vector<TrueObject>& before,
+                  const std::vector<TrueObject>& after, AttemptCheck* c) {
+  if (c->action == "KNOCK") {
+    c->outcome = "nothing";
+    for (const TrueObject& a : after) {
+      if (a.id != c->target_truth_id || Raised(a)) continue;
+      const bool in_zone =
+          c->goal_index >= 0 && c->goal_index < static_cast<int>(season.goals.size()) &&
+          platform::GoalContains(season.goals[c->goal_index], a.center_m.head<2>());
+      c->outcome = in_zone ? "scored" : "off";
+    }
+    return;
+  }
   std::vector<int> taken, released;
   for (const TrueObject& b : before) {
     for (const TrueObject& a : after) {
@@ -133,6 +160,10 @@ const std::vector<std::string>& PickOutcomes() {
 }
 const std::vector<std::string>& ScoreOutcomes() {
   static const std::vector<std::string> names = {"scored", "missed", "nothing"};
+  return names;
+}
+const std::vector<std::string>& KnockOutcomes() {
+  static const std::vector<std::string> names = {"scored", "off", "nothing"};
   return names;
 }
 
@@ -229,7 +260,8 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
     world.set_action_label(entry.action + " " + action.why);
     std::optional<AttemptCheck> attempt;
     std::optional<std::vector<TrueObject>> objects_before;
-    if (action.kind == ActionKind::kPick || action.kind == ActionKind::kScore) {
+    if (action.kind == ActionKind::kPick || action.kind == ActionKind::kScore ||
+        (action.kind == ActionKind::kNavigate && action.push)) {
       attempt = CheckAttempt(world, action, belief);
       objects_before = world.io().TrueObjects();
     }
@@ -242,8 +274,10 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
       case ActionKind::kNavigate:
         // A drive that takes twice its estimate (and 3 s) is stuck or lost: give it up. (The
         // thesis's stops are not in the estimate: no limit for them.)
-        ok = world.Navigate(action.target, action.stop_spacing_m, action.frames,
-                            action.stop_spacing_m > 0.0 ? 0.0 : 2.0 * action.expected_s + 3.0);
+        ok = action.push ? world.Push(action.target)
+                         : world.Navigate(
+                               action.target, action.stop_spacing_m, action.frames,
+                               action.stop_spacing_m > 0.0 ? 0.0 : 2.0 * action.expected_s + 3.0);
         break;
       case ActionKind::kPick:
         ok = world.Pick(action);
@@ -263,7 +297,8 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
     if (attempt) {
       attempt->ok = ok;
       const std::optional<std::vector<TrueObject>> objects_after = world.io().TrueObjects();
-      if (objects_before && objects_after) JudgeAttempt(*objects_before, *objects_after, &*attempt);
+      if (objects_before && objects_after)
+        JudgeAttempt(world.field(), *objects_before, *objects_after, &*attempt);
       result.attempts.push_back(*attempt);
     }
     entry.ok = ok;

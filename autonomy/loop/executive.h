@@ -43,7 +43,7 @@ struct ObjectReport {
 // from where; and what came of it, judged on the simulator's objects.
 struct AttemptCheck {
   double t_s = 0.0;
-  std::string action;  // PICK or SCORE
+  std::string action;  // PICK, SCORE or KNOCK (a push off a raised structure)
   bool ok = false;     // what the action reported
   Eigen::Vector2d estimate_m = Eigen::Vector2d::Zero();
   Eigen::Vector2d truth_m = Eigen::Vector2d::Zero();
@@ -51,7 +51,8 @@ struct AttemptCheck {
   double three_sigma_m = 0.0;
   bool Inside() const { return error_m <= three_sigma_m; }
 
-  // PICK: the target's kind and colour (empty: any); SCORE: the held object's, and the goal.
+  // PICK, KNOCK: the target's kind and colour (empty: any); SCORE: the held object's, and the
+  // goal (KNOCK: the zone it should land in).
   std::string kind, colour;
   int goal_index = -1;
   // From the estimated pose when the attempt began, to the believed target (PICK) or the
@@ -60,13 +61,15 @@ struct AttemptCheck {
   Eigen::Vector2d aim_m = Eigen::Vector2d::Zero();
   double range_m = 0.0;
   double bearing_rad = 0.0;
-  // PICK: the true object the belief stood for (the nearest of its kind and colour within
-  // kTargetMatch_m), and how far the belief was from it; -1 when there was none.
+  // PICK, KNOCK: the true object the belief stood for (the nearest of its kind and colour
+  // within kTargetMatch_m; KNOCK: on a raised structure), and how far the belief was from it;
+  // -1 when there was none.
   int target_truth_id = -1;
   double target_error_m = -1.0;
   // PICK: "target" (the intake took that object), "other" (it took another), "nothing".
   // SCORE: "scored" (in the goal aimed at), "missed" (released elsewhere), "nothing" (nothing
-  // left the intake).
+  // left the intake). KNOCK: "scored" (the object came down into the zone aimed at), "off"
+  // (it came down elsewhere), "nothing" (it is still up there, or there was none).
   std::string outcome;
   // PICK: the kind and colour of what the intake took (empty: nothing).
   std::string taken_kind, taken_colour;
@@ -74,6 +77,7 @@ struct AttemptCheck {
 inline constexpr double kTargetMatch_m = 0.5;
 const std::vector<std::string>& PickOutcomes();   // target, other, nothing
 const std::vector<std::string>& ScoreOutcomes();  // scored, missed, nothing
+const std::vector<std::string>& KnockOutcomes();  // scored, off, nothing
 
 struct MatchResult {
   std::string robot_io;                 // what the match ran on (RobotIo::Describe)

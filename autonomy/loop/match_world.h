@@ -158,6 +158,11 @@ class MatchWorld {
   // Gives up (false) when it has taken budget_s (<= 0: no limit).
   bool Navigate(const Eigen::Vector3d& target, double stop_spacing_m, int frames_per_stop,
                 double budget_s = 0.0);
+  // A knock: straight from where the robot stands to target.xy, whatever the map holds (the
+  // object to knock off lies on the way, and the planner would go round it), and straight back
+  // as far (pressed against the structure the robot could not turn; the way it came is clear);
+  // true when the robot got within 0.12 m of target.xy.
+  bool Push(const Eigen::Vector3d& target);
   // Final approach to an object believed at target.xy and the intake; true when the intake
   // took an object of the target's kind and colour (another one is held, but the pick
   // failed).

@@ -475,20 +475,25 @@ void PrintSummary(const MatchResult& r, std::ostream& out) {
     for (const AttemptCheck& a : r.attempts) inside += a.Inside();
     out << "  filter honesty  pose NEES in its 95 % band at " << c.in_band << " of " << c.updates
         << " updates, below (conservative) " << c.below << ", above (overconfident) " << c.above
-        << "; picks/scores with the true error inside 3-sigma: " << inside << " of "
+        << "; picks/scores/knocks with the true error inside 3-sigma: " << inside << " of "
         << r.attempts.size() << "\n";
   }
   if (!r.attempts.empty()) {
-    std::map<std::string, int> picks, scores;
-    int n_picks = 0, n_scores = 0;
+    std::map<std::string, int> picks, scores, knocks;
+    int n_picks = 0, n_scores = 0, n_knocks = 0;
     for (const AttemptCheck& a : r.attempts) {
       if (a.action == "PICK") ++picks[a.outcome], ++n_picks;
       if (a.action == "SCORE") ++scores[a.outcome], ++n_scores;
+      if (a.action == "KNOCK") ++knocks[a.outcome], ++n_knocks;
     }
     out << "  picks           " << n_picks;
     for (const std::string& k : PickOutcomes()) out << ", " << k << " " << picks[k];
     out << "; releases " << n_scores;
     for (const std::string& k : ScoreOutcomes()) out << ", " << k << " " << scores[k];
+    if (n_knocks > 0) {
+      out << "; knocks " << n_knocks;
+      for (const std::string& k : KnockOutcomes()) out << ", " << k << " " << knocks[k];
+    }
     out << "\n";
   }
   int matched = 0;

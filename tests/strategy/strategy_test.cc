@@ -5,6 +5,7 @@
 #include "field_configs/loader.h"
 #include "mapping/object_map.h"
 #include "planning/planner.h"
+#include "platform/field_geometry.h"
 #include "strategy/travel_field.h"
 
 namespace slamo::strategy {
@@ -166,9 +167,12 @@ TEST_F(StrategyTest, UnknownStrategyIsAnError) {
 // A red large ball believed on the barrier (it cannot be on the floor there: it does not fit
 // under) is not picked: the perceiving strategies knock it off, driving at it along +x so that
 // it drops into the goal zone (5) rather than back into the middle zone (1), and only once.
+// (The planner without the season's priors, which would stand in for the ball seen.)
 TEST_F(StrategyTest, ABallOnTheBarrierIsKnockedIntoTheGoalZoneNotPicked) {
+  StrategyOptions options;
+  options.raised_priors = false;
   for (const std::string name : {"planner", "greedy"}) {
-    std::unique_ptr<Strategy> strategy = MakeStrategy(name, StrategyOptions{});
+    std::unique_ptr<Strategy> strategy = MakeStrategy(name, options);
     Belief b;
     b.pose = Eigen::Vector3d(-0.9, 1.0, 0.0);
     b.objects.push_back(ObjectBelief{7, "large_ball", "red", Eigen::Vector2d(0.61, 1.0),
@@ -192,7 +196,15 @@ TEST_F(StrategyTest, ABallOnTheBarrierIsKnockedIntoTheGoalZoneNotPicked) {
     EXPECT_EQ(push.goal_index, Goal("goal_zone")) << name;
     EXPECT_GT(push.target.x(), a.target.x() + 0.2) << name;
     EXPECT_NEAR(push.target.y(), 1.0, 1e-6) << name;
-    EXPECT_TRUE(planner_->IsClear(push.target.head<2>())) << name;
+    // The bumper stops just short of the barrier: the robot's footprint there is free, and
+    // its front is past the ball's near side, so the ball is pushed off the top.
+    EXPECT_TRUE(platform::FootprintIsFree(
+        season_, platform::Pose2D{push.target.x(), push.target.y(), push.target.z()},
+        robot_.length_m, robot_.width_m, robot_.height_m))
+        << name;
+    EXPECT_GT(push.target.x() + robot_.length_m / 2.0, 0.61 - 0.2 + 0.025) << name;
+    EXPECT_NEAR(push.object_m.x(), 0.61, 1e-9) << name;
+    EXPECT_EQ(push.object_kind, "large_ball") << name;
     // Done once: believed still there, it is not pushed again.
     strategy->Feedback(push, true);
     b.pose = push.target;
@@ -207,7 +219,9 @@ TEST_F(StrategyTest, ABallOnTheBarrierIsKnockedIntoTheGoalZoneNotPicked) {
 TEST_F(StrategyTest, APickIsApproachedFromASideWhereTheTargetIsAloneInTheCorridor) {
   const Eigen::Vector2d target(-0.45, 1.0), beside(-0.33, 1.0);
   const auto first_navigation = [&](const std::string& name, bool with_neighbour) {
-    std::unique_ptr<Strategy> strategy = MakeStrategy(name, StrategyOptions{});
+    StrategyOptions options;
+    options.raised_priors = false;  // the barrier balls would be worth more
+    std::unique_ptr<Strategy> strategy = MakeStrategy(name, options);
     Belief b;
     b.pose = Eigen::Vector3d(-0.45, 0.2, M_PI / 2.0);
     b.objects.push_back(
@@ -256,6 +270,7 @@ TEST_F(StrategyTest, TheLearnedSuccessModelDecidesWhetherAPickIsWorthIt) {
     return a;
   };
   StrategyOptions options;
+  options.raised_priors = false;  // the barrier balls would be worth more
   int asked = 0;
   options.learned_success = [&](const std::string& action, const std::string& kind, double range,
                                 double, double sigma) -> std::optional<double> {
@@ -278,6 +293,78 @@ TEST_F(StrategyTest, TheLearnedSuccessModelDecidesWhetherAPickIsWorthIt) {
   };
   const Action never = first(options);
   EXPECT_FALSE(never.kind == ActionKind::kNavigate && never.object_id == 7) << never.why;
+}
+
+// The season file puts red large balls on the barrier, where they stay until knocked off: the
+// planner goes for them with nothing seen, and a red large ball seen near such a spot is that
+// ball (not a second target, not a pick).
+TEST_F(StrategyTest, ThePlannerKnocksTheSeasonsBarrierBallsUnseen) {
+  std::unique_ptr<Strategy> planner = MakeStrategy("planner", StrategyOptions{});
+  Belief b;
+  b.pose = Eigen::Vector3d(-0.9, 1.0, 0.0);
+  Action a = planner->Next(b, context_);
+  for (int k = 0; k < 5 && a.kind == ActionKind::kObserve; ++k) a = planner->Next(b, context_);
+  ASSERT_EQ(a.kind, ActionKind::kNavigate) << a.why;
+  EXPECT_LE(a.object_id, -1000) << a.why;
+  EXPECT_FALSE(a.push);
+  // Seen 0.3 m off its spot (where it would be on the floor beside the barrier), it is still
+  // the ball on the barrier: knocked, not picked.
+  b.objects.push_back(ObjectBelief{7, "large_ball", "red", Eigen::Vector2d(0.31, 1.0),
+                                   Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+  std::unique_ptr<Strategy> seen = MakeStrategy("planner", StrategyOptions{});
+  a = seen->Next(b, context_);
+  for (int k = 0; k < 5 && a.kind == ActionKind::kObserve; ++k) a = seen->Next(b, context_);
+  ASSERT_EQ(a.kind, ActionKind::kNavigate) << a.why;
+  EXPECT_NE(a.object_id, 7) << a.why;
+  EXPECT_LE(a.object_id, -1000) << a.why;
+  // Knocked: neither the spot nor the ball seen near it is a target again while believed up
+  // there.
+  b.pose = a.target;
+  Action push = seen->Next(b, context_);
+  for (int k = 0; k < 5 && push.kind == ActionKind::kObserve; ++k) push = seen->Next(b, context_);
+  ASSERT_TRUE(push.push) << push.why;
+  const int knocked = push.object_id;
+  seen->Feedback(push, true);
+  b.objects.back().position_m = Eigen::Vector2d(0.61, 1.0);
+  const Action after = seen->Next(b, context_);
+  EXPECT_NE(after.object_id, knocked) << after.why;
+  EXPECT_NE(after.object_id, 7) << after.why;
+}
+
+// Drives that took three times their estimate stretch the planner's timing: there are
+// deadlines at which the cycle fits by the raw estimates and is not started by the learned
+// ones, and none the other way round.
+TEST_F(StrategyTest, SlowDrivesMakeThePlannerStartOnlyWhatStillFits) {
+  const auto third = [&](bool learn, double deadline_s) {
+    StrategyOptions options;
+    options.learn_durations = learn;
+    options.raised_priors = false;
+    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
+    Belief b;
+    b.pose = Eigen::Vector3d(-0.45, 0.2, M_PI / 2.0);
+    b.objects.push_back(ObjectBelief{7, "buckyball", "red", Eigen::Vector2d(-0.45, 1.2),
+                                     Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    Action a = planner->Next(b, context_);  // the survey
+    b.now_s = 0.5;
+    a = planner->Next(b, context_);
+    EXPECT_EQ(a.kind, ActionKind::kNavigate) << a.why;
+    // The drive took three times its estimate and the robot is where it started.
+    b.now_s += 3.0 * a.expected_s;
+    b.deadline_s = deadline_s;
+    a = planner->Next(b, context_);
+    while (a.kind == ActionKind::kObserve && b.now_s < b.deadline_s) {
+      b.now_s += 0.2;
+      a = planner->Next(b, context_);
+    }
+    return a.kind == ActionKind::kNavigate && a.object_id == 7;
+  };
+  int only_raw = 0;
+  for (double deadline = 5.0; deadline <= 60.0; deadline += 0.5) {
+    const bool raw = third(false, deadline), learned = third(true, deadline);
+    EXPECT_FALSE(learned && !raw) << deadline;
+    only_raw += raw && !learned;
+  }
+  EXPECT_GT(only_raw, 2);
 }
 
 // The scripted route from the red hanging-zone tile, planned on the nominal layout: it
