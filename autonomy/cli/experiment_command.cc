@@ -339,7 +339,8 @@ int RunRobustnessTable(int runs, uint64_t seed, const std::string& work_dir) {
       "\nlandmark_RMSE and ATE after the trajectory's rigid alignment; mean_NEES: pose NEES (3 "
       "dof) averaged over the steps (one step's 95 %% band [%.2f, %.2f], expectation 3); "
       "rejected: measurements the filter refused (MRPT's does not say); ms_per_step: inside the "
-      "filter's step calls, on this machine. slamo runs as `slamo replay` does (adaptive).\n",
+      "filter's step calls, on this machine. slamo runs as `slamo replay` does (adaptive, "
+      "first-estimates Jacobians).\n",
       band.first, band.second);
   return 0;
 }

@@ -146,6 +146,7 @@ std::vector<RobustnessRow> RunRobustness(const RobustnessOptions& options,
   told.sigma_bearing_rad = options.bearing_sigma_deg * kPi / 180.0;
   told.max_range_m = options.max_range_m;
   told.adaptive = true;  // as `slamo replay` runs it
+  told.first_estimates = true;
   std::vector<RobustnessRow> rows;
   int done = 0;
   const int total = static_cast<int>(cases.size()) * runs;
