@@ -325,8 +325,9 @@ int RunRobustnessTable(const RobustnessArgs& args, uint64_t seed) {
     markers = field::LoadSeasonConfig(args.season).landmarks.size();
     rows = RunRobustness(options, DefaultRobustnessCases(), runs, seed, args.out,
                          [&](int done, int) { progress(done); });
-    sim_rows = RunSimRobotRows(sim_options, sim_cases, runs, seed,
-                               [&](int done, int) { progress(mrpt_total + done); });
+    sim_rows = RunSimRobotRows(
+        sim_options, sim_cases, runs, seed, [&](int done, int) { progress(mrpt_total + done); },
+        args.out);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
@@ -473,7 +474,9 @@ void RegisterExperimentCommand(CLI::App& app, CommandAction* action) {
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   robustness->add_option("--seed", args->seed, "first seed")->capture_default_str();
-  robustness->add_option("--out", robustness_args->out, "folder for the generated MRPT logs")
+  robustness
+      ->add_option("--out", robustness_args->out,
+                   "folder for the generated logs (MRPT's, and the simulator's for slamo replay)")
       ->capture_default_str();
   robustness
       ->add_option("--robot", robustness_args->second_robot,

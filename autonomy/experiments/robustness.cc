@@ -334,10 +334,38 @@ SimRobotLog SimulateRobotLog(const field::SeasonConfig& season, const field::Rob
   return log;
 }
 
+void WriteSimRobotLog(const std::string& dir, const SimRobotLog& log, double step_s) {
+  fs::create_directories(dir);
+  mapping::ReplayLog replay;
+  std::vector<mapping::TimedPose> truth;
+  for (size_t k = 0; k < log.scenario.steps.size(); ++k) {
+    const PeerStep& step = log.scenario.steps[k];
+    const double t = static_cast<double>(k) * step_s;
+    mapping::OdometryStep u = step.odometry;
+    // Step 0 has no motion: a zero step (the format wants positive sigmas) carries its
+    // measurements, so that replay's trajectory has a pose for it too.
+    if (k == 0) u = mapping::OdometryStep(0.0, 0.0, 0.0, Eigen::Matrix3d::Identity() * 1e-18);
+    replay.events.push_back({t, u});
+    for (const mapping::RangeBearing& z : step.measurements) replay.events.push_back({t, z});
+    truth.push_back({t, step.truth.x(), step.truth.y(), step.truth.z()});
+  }
+  mapping::WriteTextLog(dir + "/run.log", replay);
+  mapping::WriteTumTrajectory(dir + "/truth.tum", truth, "true pose");
+  std::ofstream landmarks(dir + "/landmarks.csv");
+  landmarks << "id,x_m,y_m\n";
+  char line[128];
+  for (const mapping::LandmarkPoint& l : log.landmarks) {
+    std::snprintf(line, sizeof(line), "%d,%.9f,%.9f\n", l.id, l.x_m, l.y_m);
+    landmarks << line;
+  }
+  if (!landmarks) throw std::runtime_error(dir + "/landmarks.csv: write failed");
+}
+
 std::vector<SimRobotRow> RunSimRobotRows(const SimRobotOptions& options,
                                          const std::vector<SimRobotCase>& cases, int runs,
                                          uint64_t seed,
-                                         const std::function<void(int, int)>& progress) {
+                                         const std::function<void(int, int)>& progress,
+                                         const std::string& out_dir) {
   if (runs < 1) throw std::invalid_argument("robustness: runs must be at least 1");
   const field::SeasonConfig season = field::LoadSeasonConfig(options.season);
   std::map<std::string, field::RobotConfig> robots;
@@ -356,6 +384,11 @@ std::vector<SimRobotRow> RunSimRobotRows(const SimRobotOptions& options,
       const SimRobotLog log =
           SimulateRobotLog(season, robots.at(c.data_robot), robots.at(c.told_robot), options,
                            seed + static_cast<uint64_t>(r));
+      if (!out_dir.empty()) {
+        WriteSimRobotLog(out_dir + "/sim_" + fs::path(c.data_robot).stem().string() + "_told_" +
+                             fs::path(c.told_robot).stem().string() + "_run" + std::to_string(r),
+                         log, options.step_s);
+      }
       PeerBenchOptions told = log.told;
       told.adaptive = true;  // as `slamo replay` runs it
       told.first_estimates = true;

@@ -104,6 +104,11 @@ SimRobotLog SimulateRobotLog(const field::SeasonConfig& season, const field::Rob
                              const field::RobotConfig& told, const SimRobotOptions& options,
                              uint64_t seed);
 
+// Writes `log` into `dir` (created) for `slamo replay`: run.log (text log, step k at k * step_s;
+// a first zero step carries step 0's measurements), truth.tum (the true pose at each step) and
+// landmarks.csv (the true markers). Throws std::runtime_error when a file cannot be written.
+void WriteSimRobotLog(const std::string& dir, const SimRobotLog& log, double step_s);
+
 // The sensor sigmas a robot file implies for one range-bearing measurement (SimRobotOptions).
 std::pair<double, double> ToldSensorSigmas(const field::CameraConfig& camera,
                                            double pixel_sigma_px);
@@ -119,11 +124,13 @@ struct SimRobotRow {
 };
 
 // Runs every case `runs` times (seeds seed, seed + 1, ...), slamo as `slamo replay` runs it
-// and MRPT's filter on the same steps. Throws field::ConfigError for a robot or season that
-// does not load.
+// and MRPT's filter on the same steps; with `out_dir`, each run's log is written to
+// <out_dir>/sim_<data>_told_<told>_run<r> (WriteSimRobotLog). Throws field::ConfigError for a
+// robot or season that does not load.
 std::vector<SimRobotRow> RunSimRobotRows(const SimRobotOptions& options,
                                          const std::vector<SimRobotCase>& cases, int runs,
                                          uint64_t seed,
-                                         const std::function<void(int done, int total)>& progress);
+                                         const std::function<void(int done, int total)>& progress,
+                                         const std::string& out_dir = "");
 
 }  // namespace slamo::autonomy

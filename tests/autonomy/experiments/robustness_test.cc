@@ -6,9 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "field_configs/loader.h"
 #include "mapping/ekf_slam.h"
+#include "mapping/metrics.h"
+#include "mapping/replay_log.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -123,6 +126,50 @@ TEST(RobustnessSimTest, BothFiltersAreToldTheToldRobotsNoise) {
       EXPECT_EQ(z.covariance(1, 1), bearing_sigma * bearing_sigma);
     }
   }
+}
+
+TEST(RobustnessSimTest, TheWrittenLogReplaysTheSameSteps) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  const field::RobotConfig v5 = field::LoadRobotConfig("v5_drivetrain");
+  const SimRobotOptions options;
+  const SimRobotLog log = SimulateRobotLog(season, v5, v5, options, 3);
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / "slamo_robustness_sim_log").string();
+  std::filesystem::remove_all(dir);
+  WriteSimRobotLog(dir, log, options.step_s);
+  const mapping::ReplayLog replay = mapping::ReadTextLog(dir + "/run.log");
+  const std::vector<mapping::TimedPose> truth = mapping::ReadTumTrajectory(dir + "/truth.tum");
+  const std::vector<mapping::LandmarkPoint> landmarks =
+      mapping::ReadLandmarkCsv(dir + "/landmarks.csv");
+  ASSERT_EQ(truth.size(), log.scenario.steps.size());
+  ASSERT_EQ(landmarks.size(), log.landmarks.size());
+  EXPECT_NEAR(landmarks[2].x_m, log.landmarks[2].x_m, 1e-9);
+  // One odometry event per step (a zero one first), then that step's measurements.
+  size_t step = 0, measurement = 0;
+  bool first = true;
+  for (const mapping::LogEvent& e : replay.events) {
+    if (e.is_odometry()) {
+      step = first ? 0 : step + 1;
+      first = false;
+      measurement = 0;
+      ASSERT_LT(step, log.scenario.steps.size());
+      EXPECT_NEAR(e.t_s, step * options.step_s, 1e-9);
+      if (step > 0) {
+        const mapping::OdometryStep& u = log.scenario.steps[step].odometry;
+        EXPECT_NEAR(e.odometry().dx_m, u.dx_m, 1e-9);
+        EXPECT_NEAR(e.odometry().dtheta_rad, u.dtheta_rad, 1e-9);
+        EXPECT_TRUE(e.odometry().covariance->isApprox(*u.covariance, 1e-9));
+      }
+    } else {
+      const mapping::RangeBearing& z = log.scenario.steps[step].measurements.at(measurement++);
+      EXPECT_EQ(e.measurement().id, z.id);
+      EXPECT_NEAR(e.measurement().range_m, z.range_m, 1e-9);
+      EXPECT_NEAR(e.measurement().bearing_rad, z.bearing_rad, 1e-9);
+    }
+    EXPECT_NEAR(truth[step].x_m, log.scenario.steps[step].truth.x(), 1e-6);
+  }
+  EXPECT_EQ(step + 1, log.scenario.steps.size());
+  std::filesystem::remove_all(dir);
 }
 
 TEST(RobustnessSimTest, SlamoMapsTheSecondRobotWhetherToldItsNoiseOrTheThesisRobots) {
