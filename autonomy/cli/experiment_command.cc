@@ -396,10 +396,18 @@ int RunRobustnessTable(const RobustnessArgs& args, uint64_t seed) {
   for (const SimRobotRow& row : sim_rows) {
     std::printf(
         "%s told %s: %.0f steps, %.1f m, %.2f markers seen a step, heading from %s; told range "
-        "sd %.4f m, bearing sd %.3f deg\n",
+        "sd %.4f m, bearing sd %.3f deg, max range %.2f m\n",
         row.robots.data_robot.c_str(), row.robots.told_robot.c_str(), row.steps, row.distance_m,
         row.measurements_per_step, row.gyro ? "the inertial sensor" : "the encoders",
-        row.range_sigma_m, row.bearing_sigma_rad * 180.0 / M_PI);
+        row.range_sigma_m, row.bearing_sigma_rad * 180.0 / M_PI, row.max_range_m);
+  }
+  if (!sim_rows.empty()) {
+    std::printf(
+        "each run's log is in %s/sim_<data>_told_<told>_run<r> (run.log, truth.tum, "
+        "landmarks.csv): `slamo replay --log run.log --truth truth.tum --landmarks-truth "
+        "landmarks.csv --start-sigma-m 0 --start-sigma-rad 0 --max-range <max range>` replays "
+        "slamo's row\n",
+        args.out.c_str());
   }
   return 0;
 }

@@ -409,6 +409,7 @@ std::vector<SimRobotRow> RunSimRobotRows(const SimRobotOptions& options,
       row.gyro = log.gyro;
       row.range_sigma_m = told.sigma_range_m;
       row.bearing_sigma_rad = told.sigma_bearing_rad;
+      row.max_range_m = told.max_range_m;
       if (progress) progress(++done, total);
     }
     row.mrpt.rejected_fraction = -1.0;

@@ -121,6 +121,7 @@ struct SimRobotRow {
   double distance_m = 0.0;             // per run (mean)
   bool gyro = false;
   double range_sigma_m = 0.0, bearing_sigma_rad = 0.0;  // what both filters were told
+  double max_range_m = 0.0;                             // likewise
 };
 
 // Runs every case `runs` times (seeds seed, seed + 1, ...), slamo as `slamo replay` runs it
