@@ -175,8 +175,8 @@ TEST(RobustnessSimTest, TheWrittenLogReplaysTheSameSteps) {
 TEST(RobustnessSimTest, SlamoMapsTheSecondRobotWhetherToldItsNoiseOrTheThesisRobots) {
   // Seeds 1-3, as `slamo experiment robustness --runs 3` prints them. Measured: told its own
   // file, landmark RMSE 0.0165 m, ATE 0.0147 m, mean NEES 3.7; told the thesis robot's (whose
-  // Kinect's depth sigma is a sixteenth of the D435's), 0.0104 m, 0.0157 m and 1.7, where MRPT's filter
-  // on the same steps is 4x worse and overconfident (0.041 m, 0.051 m, NEES 111).
+  // Kinect's depth sigma is a sixteenth of the D435's), 0.0104 m, 0.0157 m and 1.7, where MRPT's
+  // filter on the same steps is 4x worse and overconfident (0.041 m, 0.051 m, NEES 111).
   const std::vector<SimRobotRow> rows = RunSimRobotRows(
       SimRobotOptions{}, {{"v5_drivetrain", "v5_drivetrain"}, {"v5_drivetrain", "thesis_robot"}}, 3,
       1, nullptr);
