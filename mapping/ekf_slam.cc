@@ -78,7 +78,7 @@ double Chi2Quantile(double p, int dof) {
 
 EkfSlam::EkfSlam(const Eigen::Vector3d& start_pose, const Eigen::Matrix3d& start_covariance,
                  const EkfOptions& options)
-    : options_(options), x_(start_pose), p_(start_covariance) {}
+    : options_(options), x_(start_pose), p_(start_covariance), step_prior_(start_pose) {}
 
 Eigen::Vector3d EkfSlam::Move(const Eigen::Vector3d& pose, const OdometryStep& u,
                               Eigen::Matrix3d* f_pose, Eigen::Matrix3d* f_u) {
@@ -126,6 +126,12 @@ void EkfSlam::Predict(const OdometryStep& u) {
   if (options_.adaptive.enabled) CheckStep();
   Eigen::Matrix3d f_pose, f_u;
   x_.head<3>() = Move(x_.head<3>(), u, &f_pose, &f_u);
+  if (options_.first_estimates) {
+    // The heading column from the two predicted poses, not the updated one and the increment.
+    f_pose(0, 2) = -(x_(1) - step_prior_.y());
+    f_pose(1, 2) = x_(0) - step_prior_.x();
+  }
+  step_prior_ = x_.head<3>();
   // P = F P F^T + G Q G^T, touching only the pose rows and columns.
   const int n = static_cast<int>(x_.size());
   const Eigen::Matrix3d q = u.covariance ? *u.covariance : MotionCovariance(u);
@@ -171,19 +177,30 @@ Eigen::Vector2d EkfSlam::InverseObserve(const Eigen::Vector3d& pose, double rang
   return Eigen::Vector2d(pose.x() + range_m * c, pose.y() + range_m * s);
 }
 
-double EkfSlam::Mahalanobis2(const RangeBearing& z, int index) const {
+Eigen::Vector2d EkfSlam::Innovation(const RangeBearing& z, int index,
+                                    Eigen::Matrix<double, 2, 3>* h_pose,
+                                    Eigen::Matrix2d* h_landmark) const {
   const Eigen::Vector3d pose = x_.head<3>();
   const Eigen::Vector2d l = landmark(index);
+  if (options_.first_estimates) {
+    ObserveJacobians(step_prior_, first_landmarks_[index], h_pose, h_landmark);
+  } else {
+    ObserveJacobians(pose, l, h_pose, h_landmark);
+  }
+  Eigen::Vector2d e = Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(pose, l);
+  e.y() = Wrap(e.y());
+  return e;
+}
+
+double EkfSlam::Mahalanobis2(const RangeBearing& z, int index) const {
   Eigen::Matrix<double, 2, 3> h_pose;
   Eigen::Matrix2d h_l;
-  ObserveJacobians(pose, l, &h_pose, &h_l);
+  const Eigen::Vector2d e = Innovation(z, index, &h_pose, &h_l);
   const int j = 3 + 2 * index;
   const Eigen::Matrix2d s = h_pose * p_.topLeftCorner<3, 3>() * h_pose.transpose() +
                             h_pose * p_.block<3, 2>(0, j) * h_l.transpose() +
                             h_l * p_.block<2, 3>(j, 0) * h_pose.transpose() +
                             h_l * p_.block<2, 2>(j, j) * h_l.transpose() + NoiseOf(z);
-  Eigen::Vector2d e = Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(pose, l);
-  e.y() = Wrap(e.y());
   return e.dot(s.ldlt().solve(e));
 }
 
@@ -191,15 +208,12 @@ double EkfSlam::ApplyUpdate(const RangeBearing& z, int index) {
   const int j = 3 + 2 * index;
   Eigen::Matrix<double, 2, 3> h_pose;
   Eigen::Matrix2d h_l;
-  ObserveJacobians(x_.head<3>(), landmark(index), &h_pose, &h_l);
+  const Eigen::Vector2d e = Innovation(z, index, &h_pose, &h_l);
   // Only the pose and this landmark's columns of H are non-zero: P H^T from those.
   pht_.noalias() = p_.leftCols<3>() * h_pose.transpose();
   pht_.noalias() += p_.middleCols<2>(j) * h_l.transpose();
   const Eigen::Matrix2d s = h_pose * pht_.topRows<3>() + h_l * pht_.middleRows<2>(j) + NoiseOf(z);
   gain_.noalias() = pht_ * s.inverse();
-  Eigen::Vector2d e =
-      Eigen::Vector2d(z.range_m, z.bearing_rad) - Observe(x_.head<3>(), landmark(index));
-  e.y() = Wrap(e.y());
   x_.noalias() += gain_ * e;
   x_(2) = Wrap(x_(2));
   // Joseph form (I - K H) P (I - K H)^T + K R K^T, multiplied out so that no n x n x n product
@@ -372,6 +386,7 @@ int EkfSlam::AddLandmark(const RangeBearing& z) {
   Symmetrise(&p_);
   ids_.push_back(z.id);
   signatures_.push_back(z.signature);
+  first_landmarks_.push_back(l);
   return static_cast<int>(ids_.size()) - 1;
 }
 
@@ -386,6 +401,7 @@ void EkfSlam::AddKnownLandmark(const Eigen::Vector2d& position, const Eigen::Mat
   p_ = std::move(grown);
   ids_.push_back(id);
   signatures_.push_back(signature);
+  first_landmarks_.push_back(position);
 }
 
 UpdateOutcome EkfSlam::Update(const RangeBearing& z) { return Count(Associate(z)); }
@@ -461,7 +477,6 @@ std::vector<int> EkfSlam::JointCompatibility(const std::vector<RangeBearing>& fr
   }
   // Joint Mahalanobis distance of a hypothesis (pairs measurement -> landmark).
   // S = H P H^T + R over the pose and the paired landmarks only (H is zero elsewhere).
-  const Eigen::Vector3d pose = x_.head<3>();
   const auto joint_d2 = [&](const std::vector<std::pair<int, int>>& pairs) {
     const int k = static_cast<int>(pairs.size());
     const int size = 3 + 2 * k;
@@ -478,13 +493,9 @@ std::vector<int> EkfSlam::JointCompatibility(const std::vector<RangeBearing>& fr
       const auto [i, j] = pairs[p];
       Eigen::Matrix<double, 2, 3> h_pose;
       Eigen::Matrix2d h_l;
-      ObserveJacobians(pose, landmark(j), &h_pose, &h_l);
+      e.segment<2>(2 * p) = Innovation(frame[i], j, &h_pose, &h_l);
       h.block<2, 3>(2 * p, 0) = h_pose;
       h.block<2, 2>(2 * p, 3 + 2 * p) = h_l;
-      Eigen::Vector2d d =
-          Eigen::Vector2d(frame[i].range_m, frame[i].bearing_rad) - Observe(pose, landmark(j));
-      d.y() = Wrap(d.y());
-      e.segment<2>(2 * p) = d;
       r.block<2, 2>(2 * p, 2 * p) = NoiseOf(frame[i]);
     }
     const Eigen::MatrixXd s = h * p_sub * h.transpose() + r;

@@ -129,6 +129,19 @@ struct EkfOptions {
   // false: the map is surveyed and complete; a measurement that pairs with no landmark is
   // dropped instead of starting a new one (UpdateFrame reports it kRejected).
   bool add_landmarks = true;
+  // First-estimates Jacobians (FEJ-EKF: Huang, Mourikis and Roumeliotis, "Observability-based
+  // rules for designing consistent EKF SLAM estimators", IJRR 2010). The standard EKF evaluates
+  // each Jacobian at the latest estimate: a landmark's at every update after it moved, and the
+  // pose's after each measurement of a step moved it. The linearised system then seems to
+  // observe the map's global position and heading, which nothing measures, and the filter
+  // grows overconfident in them and weighs the next measurements wrongly. With this option
+  // the measurement Jacobians use the pose as predicted for the step (before any of its
+  // measurements) and each landmark's first estimate (where it was initialised, or surveyed),
+  // and the prediction's Jacobian the difference of two successive predicted poses: the
+  // unobservable directions stay unobservable. Innovations are still taken at the latest
+  // estimate. Off by default (the matches); `slamo replay` and the robustness experiment
+  // turn it on.
+  bool first_estimates = false;
 };
 
 // What an update did with each measurement.
@@ -196,6 +209,10 @@ class EkfSlam {
   double Mahalanobis2(const RangeBearing& z, int index) const;
 
  private:
+  // The innovation of `z` against landmark `index` at the latest estimate, with the
+  // measurement Jacobians at the linearisation point (EkfOptions::first_estimates).
+  Eigen::Vector2d Innovation(const RangeBearing& z, int index, Eigen::Matrix<double, 2, 3>* h_pose,
+                             Eigen::Matrix2d* h_landmark) const;
   // Update without counting the outcome (Update and UpdateFrame count).
   UpdateOutcome Associate(const RangeBearing& z);
   // Returns the measurement's NIS against the prediction.
@@ -221,6 +238,10 @@ class EkfSlam {
   Eigen::Matrix<double, Eigen::Dynamic, 2> pht_, gain_, gain_s_;  // update scratch, kept sized
   std::vector<int> ids_;
   std::vector<std::string> signatures_;
+  // First estimates (EkfOptions::first_estimates): the pose as predicted for this step, and
+  // each landmark where it was first placed.
+  Eigen::Vector3d step_prior_;
+  std::vector<Eigen::Vector2d> first_landmarks_;
   FilterCounters counters_;
   std::deque<double> nis_window_;
   double q_scale_ = 1.0;

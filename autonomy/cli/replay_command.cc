@@ -36,6 +36,7 @@ struct FilterArgs {
   std::optional<bool> known_ids;                   // false: associate every measurement by position
   std::optional<std::string> odometry_covariance;  // log | model
   std::optional<bool> adaptive;
+  std::optional<bool> first_estimates;  // Jacobians at the first estimates (FEJ-EKF)
 };
 
 struct ReplayArgs {
@@ -103,17 +104,21 @@ void ReadFilterConfig(const std::string& path, FilterArgs* filter) {
         if (!filter->odometry_covariance) filter->odometry_covariance = v.as<std::string>();
       } else if (key == "adaptive") {
         if (!filter->adaptive) filter->adaptive = v.as<bool>();
+      } else if (key == "first_estimates") {
+        if (!filter->first_estimates) filter->first_estimates = v.as<bool>();
       } else {
         throw FilterError(where +
                           ": unknown key; expected motion_per_m, motion_per_rad, "
                           "range_sigma_m, bearing_sigma_deg, max_range_m, fov_deg, "
-                          "gate_probability, known_ids, odometry_covariance or adaptive");
+                          "gate_probability, known_ids, odometry_covariance, adaptive or "
+                          "first_estimates");
       }
     } catch (const YAML::Exception&) {
+      const bool boolean = key == "known_ids" || key == "adaptive" || key == "first_estimates";
       throw FilterError(where + ": expected " +
-                        (key == "known_ids" || key == "adaptive" ? "true or false"
-                         : key == "odometry_covariance"          ? "log or model"
-                                                                 : "a number"));
+                        (boolean                        ? "true or false"
+                         : key == "odometry_covariance" ? "log or model"
+                                                        : "a number"));
     }
   }
 }
@@ -140,6 +145,7 @@ void CheckFilter(const FilterArgs& f) {
 mapping::EkfOptions FilterOptions(const FilterArgs& f) {
   mapping::EkfOptions options;
   options.adaptive.enabled = f.adaptive.value_or(true);
+  options.first_estimates = f.first_estimates.value_or(true);
   if (f.motion_per_m) {
     options.motion.sigma_per_m = *f.motion_per_m;
     options.motion.lateral_sigma_per_m = *f.motion_per_m;
@@ -366,6 +372,12 @@ void RegisterReplayCommand(CLI::App& app, CommandAction* action) {
       ->add_option("--adaptive", f->adaptive,
                    "true: the filter raises its process noise when innovations stay larger "
                    "than predicted and widens a lost pose; false: fixed noise")
+      ->default_str("true");
+  replay
+      ->add_option("--first-estimates", f->first_estimates,
+                   "true: measurement Jacobians at the step's predicted pose and each "
+                   "landmark's first estimate (FEJ-EKF, consistent); false: at the latest "
+                   "estimate (the textbook EKF)")
       ->default_str("true");
   replay->footer(
       "Examples:\n"

@@ -153,6 +153,7 @@ PeerTrack RunSlamoFilter(const PeerScenario& scenario, const PeerBenchOptions& o
   ekf.motion = PeerMotionNoise(options);
   ekf.max_range_m = options.max_range_m;
   ekf.adaptive.enabled = options.adaptive;
+  ekf.first_estimates = options.first_estimates;
   // Known start, as MRPT's filter (it starts at (0, 0, 0) with zero covariance).
   mapping::EkfSlam filter(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero(), ekf);
   PeerTrack track;
@@ -182,14 +183,14 @@ PeerTrack RunMrptFilter(const PeerScenario& scenario, const PeerBenchOptions& op
   // used only for measurements without one.
   filter.KF_options.method = mrpt::bayes::kfEKFNaive;
 
-  mrpt::math::CMatrixDouble33 q;
-  const Eigen::Matrix3d step_cov = PeerStepCovariance(options);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) q(r, c) = step_cov(r, c);
-
+  const Eigen::Matrix3d model_cov = PeerStepCovariance(options);
   PeerTrack track;
   for (size_t k = 0; k < scenario.steps.size(); ++k) {
     const PeerStep& step = scenario.steps[k];
+    mrpt::math::CMatrixDouble33 q;
+    const Eigen::Matrix3d step_cov = step.odometry.covariance.value_or(model_cov);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) q(r, c) = step_cov(r, c);
     // Step 0 is a zero move: MRPT skips prediction until its map holds a landmark anyway.
     auto actions = mrpt::obs::CActionCollection::Create();
     {

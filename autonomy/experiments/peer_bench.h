@@ -28,7 +28,8 @@ struct PeerBenchOptions {
   double sigma_bearing_rad = 0.017453292519943295;  // bearing noise (1 deg)
   double sigma_step_xy_m = 0.005;                   // odometry noise per step, forward and sideways
   double sigma_step_heading_rad = 0.01;             // odometry heading noise per step
-  bool adaptive = false;  // slamo's filter checks itself (mapping::AdaptiveOptions)
+  bool adaptive = false;         // slamo's filter checks itself (mapping::AdaptiveOptions)
+  bool first_estimates = false;  // slamo's filter: first-estimates Jacobians (mapping::EkfOptions)
 };
 
 // The motion noise slamo's filter is given: a fixed covariance per step, the one the
@@ -65,7 +66,8 @@ struct PeerTrack {
 
 // slamo's EkfSlam: Predict, then Update with each measurement, per step.
 PeerTrack RunSlamoFilter(const PeerScenario& scenario, const PeerBenchOptions& options);
-// MRPT's CRangeBearingKFSLAM2D: one processActionObservation per step.
+// MRPT's CRangeBearingKFSLAM2D: one processActionObservation per step, the step's odometry
+// covariance its own where it has one (else PeerStepCovariance), as slamo's filter uses it.
 PeerTrack RunMrptFilter(const PeerScenario& scenario, const PeerBenchOptions& options);
 
 // The truth as a trajectory, timestamped like the tracks.

@@ -9,6 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/experiments/peer_bench.h"
+#include "field_configs/robot_config.h"
+#include "field_configs/season_config.h"
+#include "mapping/metrics.h"
+#include "platform/drive_base.h"
+
 namespace slamo::autonomy {
 
 struct RobustnessOptions {
@@ -51,5 +57,81 @@ std::vector<RobustnessRow> RunRobustness(const RobustnessOptions& options,
                                          const std::vector<RobustnessCase>& cases, int runs,
                                          uint64_t seed, const std::string& work_dir,
                                          const std::function<void(int done, int total)>& progress);
+
+// Rows from our own simulator, with a robot other than the one the filter's defaults were
+// measured on. The data robot's drive (its physics, wheel base, speed and slip model, and its
+// inertial sensor for the heading when its file has one, as a match uses it) drives `script`
+// from `start`; every `step_s` of simulated time is one filter step: the dead-reckoned
+// odometry since the last step, and a range-bearing measurement of each season marker the
+// data robot's camera sees (projected into its image, depth within its range, then 1 px of
+// noise on the marker's centre and its depth table's sigma on the depth, and back to range and
+// bearing from the robot centre as vision measures them). No renderer and no detector: the
+// markers' ids are known to both filters, nothing occludes them. Both filters are told the
+// noise of `told_robot`'s file: per step, its odometry model's covariance of that step; for
+// the sensor, one range sigma (the RMS of its camera's depth sigma over the camera's range)
+// and one bearing sigma (1 px over its focal length).
+struct SimRobotOptions {
+  std::string season = "toss_up";
+  // Two laps of a 2.4 m square inside the field, turning left.
+  std::string script =
+      "forward 2.4; turn 90; forward 2.4; turn 90; forward 2.4; turn 90; forward 2.4; turn 90; "
+      "forward 2.4; turn 90; forward 2.4; turn 90; forward 2.4; turn 90; forward 2.4; turn 90";
+  platform::Pose2D start{-1.2, -1.2, 0.0};
+  double step_s = 0.1;          // simulated time per filter step
+  double pixel_sigma_px = 1.0;  // noise of a marker's centre in the image
+};
+
+// Which robot drives, and whose noise both filters are told (robot names or files).
+struct SimRobotCase {
+  std::string data_robot;
+  std::string told_robot;
+};
+// The second robot told the thesis robot's noise (a new user's likely mistake), then told its
+// own file's; the thesis robot told its own when it is the one named.
+std::vector<SimRobotCase> DefaultSimRobotCases(const std::string& second_robot = "v5_drivetrain");
+
+// One simulated run, in the frame of the start pose (where both filters start, known).
+struct SimRobotLog {
+  PeerScenario scenario;                          // told noise on every step and measurement
+  std::vector<mapping::LandmarkPoint> landmarks;  // the true markers, id = season index
+  PeerBenchOptions told;                          // the sensor sigmas and range both are told
+  double distance_m = 0.0;                        // travelled (true)
+  bool gyro = false;                              // the heading came from the inertial sensor
+};
+// Throws platform::DriveScriptError for a bad script, std::invalid_argument when no marker is
+// in view at the start (MRPT's filter would then skip the first steps).
+SimRobotLog SimulateRobotLog(const field::SeasonConfig& season, const field::RobotConfig& data,
+                             const field::RobotConfig& told, const SimRobotOptions& options,
+                             uint64_t seed);
+
+// Writes `log` into `dir` (created) for `slamo replay`: run.log (text log, step k at k * step_s;
+// a first zero step carries step 0's measurements), truth.tum (the true pose at each step) and
+// landmarks.csv (the true markers). Throws std::runtime_error when a file cannot be written.
+void WriteSimRobotLog(const std::string& dir, const SimRobotLog& log, double step_s);
+
+// The sensor sigmas a robot file implies for one range-bearing measurement (SimRobotOptions).
+std::pair<double, double> ToldSensorSigmas(const field::CameraConfig& camera,
+                                           double pixel_sigma_px);
+
+struct SimRobotRow {
+  SimRobotCase robots;
+  RobustnessScore slamo, mrpt;
+  double steps = 0.0;                  // filter steps per run (mean)
+  double measurements_per_step = 0.0;  // mean
+  double distance_m = 0.0;             // per run (mean)
+  bool gyro = false;
+  double range_sigma_m = 0.0, bearing_sigma_rad = 0.0;  // what both filters were told
+  double max_range_m = 0.0;                             // likewise
+};
+
+// Runs every case `runs` times (seeds seed, seed + 1, ...), slamo as `slamo replay` runs it
+// and MRPT's filter on the same steps; with `out_dir`, each run's log is written to
+// <out_dir>/sim_<data>_told_<told>_run<r> (WriteSimRobotLog). Throws field::ConfigError for a
+// robot or season that does not load.
+std::vector<SimRobotRow> RunSimRobotRows(const SimRobotOptions& options,
+                                         const std::vector<SimRobotCase>& cases, int runs,
+                                         uint64_t seed,
+                                         const std::function<void(int done, int total)>& progress,
+                                         const std::string& out_dir = "");
 
 }  // namespace slamo::autonomy

@@ -1,5 +1,6 @@
 // The EKF on logs it was not tuned to: odometry noisier than its motion model, a kidnapped
 // robot, and a log that matches the model (its NIS must then sit near its expectation).
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -77,11 +78,13 @@ struct Outcome {
   FilterCounters counters;
   double final_scale = 1.0;
   double final_sensor_scale = 1.0;
+  double mean_nees = 0.0;  // pose NEES after each step's measurements, over the steps
 };
 
-Outcome Replay(const LoggedRun& run, bool adaptive) {
+Outcome Replay(const LoggedRun& run, bool adaptive, bool first_estimates = false) {
   EkfOptions options;
   options.adaptive.enabled = adaptive;
+  options.first_estimates = first_estimates;
   options.max_range_m = 4.5;
   EkfSlam ekf(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-6, options);
   Outcome out;
@@ -96,6 +99,8 @@ Outcome Replay(const LoggedRun& run, bool adaptive) {
     truth.push_back(run.truth[k].head<2>());
     estimate.push_back(ekf.pose().head<2>());
     out.error_m.push_back((truth.back() - estimate.back()).norm());
+    out.mean_nees += PoseNees(run.truth[k], ekf.pose(), ekf.pose_covariance()) /
+                     static_cast<double>(run.steps.size());
   }
   const AteResult ate = PairedTrajectoryError(truth, estimate, /*align=*/true);
   out.ate_m = ate.rmse_m;
@@ -194,6 +199,35 @@ TEST(AdaptiveEkfTest, AKidnappedRobotIsReacquiredWithinAFewSteps) {
   // The filter as it was stays lost.
   EXPECT_EQ(fixed.counters.reacquired, 0);
   EXPECT_GT(fixed.error_m[kidnap + 10], 0.3);
+}
+
+TEST(AdaptiveEkfTest, FirstEstimatesJacobiansMapBetterWhereTheModelIsRight) {
+  // Ten logs that match the model: the textbook EKF, Jacobians at the latest estimate, against
+  // the first-estimates EKF (FEJ). Relinearising at estimates that moved makes the textbook
+  // filter believe it observes the map's heading; measured on seeds 1-10 its landmark RMSE is
+  // 0.005-0.022 m against FEJ's 0.0016-0.0046 m, its ATE 0.008-0.018 m against 0.006-0.007 m,
+  // and its worst seed's mean pose NEES 9.0 against 5.2.
+  double standard_rmse = 0.0, fej_rmse = 0.0, standard_worst_nees = 0.0, fej_worst_nees = 0.0;
+  for (int seed = 1; seed <= 10; ++seed) {
+    const LoggedRun run = MakeRun(1.0, seed);
+    const Outcome standard = Replay(run, /*adaptive=*/false, /*first_estimates=*/false);
+    const Outcome fej = Replay(run, /*adaptive=*/false, /*first_estimates=*/true);
+    SCOPED_TRACE("seed " + std::to_string(seed) + ": landmarks " +
+                 std::to_string(standard.landmark_rmse_m) + " against FEJ " +
+                 std::to_string(fej.landmark_rmse_m) + ", ATE " + std::to_string(standard.ate_m) +
+                 " against " + std::to_string(fej.ate_m));
+    EXPECT_LT(fej.landmark_rmse_m, standard.landmark_rmse_m);
+    EXPECT_LT(fej.ate_m, standard.ate_m);
+    EXPECT_LT(fej.landmark_rmse_m, 0.006);
+    EXPECT_LT(fej.ate_m, 0.01);
+    standard_rmse += standard.landmark_rmse_m / 10.0;
+    fej_rmse += fej.landmark_rmse_m / 10.0;
+    standard_worst_nees = std::max(standard_worst_nees, standard.mean_nees);
+    fej_worst_nees = std::max(fej_worst_nees, fej.mean_nees);
+  }
+  EXPECT_LT(fej_rmse, 0.5 * standard_rmse);
+  EXPECT_LT(fej_worst_nees, standard_worst_nees);
+  EXPECT_LT(fej_worst_nees, 9.35);  // inside one step's 95 % band (3 dof)
 }
 
 TEST(AdaptiveEkfTest, AStepsOwnCovarianceReplacesTheMotionModel) {

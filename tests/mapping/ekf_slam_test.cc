@@ -174,6 +174,53 @@ TEST(EkfSlamTest, UpdateEqualsTheFullJosephForm) {
   }
 }
 
+TEST(EkfSlamTest, FirstEstimatesUpdateIsTheJosephFormAtThePredictedPoseAndFirstLandmark) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  EkfOptions options;
+  options.first_estimates = true;
+  EkfSlam ekf(Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Matrix3d::Identity() * 1e-2, options);
+  const Eigen::Matrix2d r = Eigen::Vector2d(4e-4, 3e-4).asDiagonal();
+  std::vector<Eigen::Vector2d> first;  // each landmark where it was placed
+  for (int id = 0; id < 10; ++id) {
+    ekf.Update({1.0 + 0.2 * id, -1.2 + 0.25 * id, r, id, "marker"});
+    first.push_back(ekf.landmark(id));
+    ekf.Predict(OdometryStep{0.05, 0.01, 0.02});
+  }
+  const Eigen::Vector3d predicted = ekf.pose();  // this step's prior: every update below uses it
+  for (int trial = 0; trial < 20; ++trial) {
+    const int index = trial % ekf.landmark_count();
+    const Eigen::MatrixXd p = ekf.covariance();
+    const Eigen::VectorXd x = ekf.state();
+    const Eigen::Vector2d z = EkfSlam::Observe(x.head<3>(), ekf.landmark(index)) +
+                              Eigen::Vector2d(0.01 * n01(rng), 0.01 * n01(rng));
+    if (trial > 0) {
+      ASSERT_GT((x.head<3>() - predicted).norm(), 0.0) << "moved since predicted";
+    }
+    Eigen::Matrix<double, 2, 3> h_pose;
+    Eigen::Matrix2d h_l;
+    EkfSlam::ObserveJacobians(predicted, first[index], &h_pose, &h_l);
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2, x.size());
+    h.leftCols<3>() = h_pose;
+    h.block<2, 2>(0, 3 + 2 * index) = h_l;
+    const Eigen::MatrixXd k = p * h.transpose() * (h * p * h.transpose() + r).inverse();
+    const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(x.size(), x.size()) - k * h;
+    const Eigen::MatrixXd expected = ikh * p * ikh.transpose() + k * r * k.transpose();
+    // The innovation is still taken at the latest estimate.
+    Eigen::Vector2d e = z - EkfSlam::Observe(x.head<3>(), ekf.landmark(index));
+    e.y() = std::remainder(e.y(), 2.0 * M_PI);
+    const Eigen::VectorXd expected_x = x + k * e;
+
+    ASSERT_EQ(ekf.Update({z.x(), z.y(), r, ekf.landmark_id(index), "marker"}),
+              UpdateOutcome::kUpdated);
+    EXPECT_LT((ekf.covariance() - expected).cwiseAbs().maxCoeff(), 1e-12 * p.cwiseAbs().maxCoeff())
+        << "trial " << trial;
+    Eigen::VectorXd dx = ekf.state() - expected_x;
+    dx(2) = std::remainder(dx(2), 2.0 * M_PI);
+    EXPECT_LT(dx.cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial;
+  }
+}
+
 TEST(EkfSlamTest, NearestNeighbourAssociationMakesNoDuplicates) {
   Simulation sim;
   std::mt19937_64 rng(7);
