@@ -17,6 +17,15 @@
 namespace slamo::autonomy {
 namespace {
 
+// The robustness tables' "rejected" column: the fraction the filter refused, or "-" when the
+// filter does not say (MRPT's).
+std::string RejectedText(const RobustnessScore& s) {
+  if (s.rejected_fraction < 0.0) return "-";
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f %%", 100.0 * s.rejected_fraction);
+  return text;
+}
+
 struct ExperimentArgs {
   std::string season = field::kDefaultSeason;
   std::string robot = field::kDefaultRobot;
@@ -344,17 +353,12 @@ int RunRobustnessTable(const RobustnessArgs& args, uint64_t seed) {
   for (const RobustnessRow& row : rows) {
     for (int f = 0; f < 2; ++f) {
       const RobustnessScore& s = f == 0 ? row.slamo : row.mrpt;
-      char rejected[32];
-      if (s.rejected_fraction < 0.0) {
-        std::snprintf(rejected, sizeof(rejected), "-");
-      } else {
-        std::snprintf(rejected, sizeof(rejected), "%.1f %%", 100.0 * s.rejected_fraction);
-      }
+      const std::string rejected = RejectedText(s);
       std::printf("%-8s %-7s %-6s %16.4f %10.4f %10.2f %9s %12.4f\n",
                   (std::to_string(row.noise.motion_factor).substr(0, 4) + "x").c_str(),
                   (std::to_string(row.noise.sensor_factor).substr(0, 4) + "x").c_str(),
-                  f == 0 ? "slamo" : "mrpt", s.landmark_rmse_m, s.ate_m, s.mean_nees, rejected,
-                  s.ms_per_step);
+                  f == 0 ? "slamo" : "mrpt", s.landmark_rmse_m, s.ate_m, s.mean_nees,
+                  rejected.c_str(), s.ms_per_step);
     }
   }
   const std::pair<double, double> band = mapping::NeesBand(3, 1);
@@ -380,16 +384,11 @@ int RunRobustnessTable(const RobustnessArgs& args, uint64_t seed) {
   for (const SimRobotRow& row : sim_rows) {
     for (int f = 0; f < 2; ++f) {
       const RobustnessScore& s = f == 0 ? row.slamo : row.mrpt;
-      char rejected[32];
-      if (s.rejected_fraction < 0.0) {
-        std::snprintf(rejected, sizeof(rejected), "-");
-      } else {
-        std::snprintf(rejected, sizeof(rejected), "%.1f %%", 100.0 * s.rejected_fraction);
-      }
+      const std::string rejected = RejectedText(s);
       std::printf("%-14s %-14s %-6s %16.4f %10.4f %10.2f %9s %12.4f\n",
                   row.robots.data_robot.c_str(), row.robots.told_robot.c_str(),
-                  f == 0 ? "slamo" : "mrpt", s.landmark_rmse_m, s.ate_m, s.mean_nees, rejected,
-                  s.ms_per_step);
+                  f == 0 ? "slamo" : "mrpt", s.landmark_rmse_m, s.ate_m, s.mean_nees,
+                  rejected.c_str(), s.ms_per_step);
     }
   }
   std::printf("\n");
