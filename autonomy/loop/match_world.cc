@@ -384,7 +384,8 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
     Eigen::Vector3d pose = slam_.pose();
     if (!planner_->IsClear(pose.head<2>())) {
       // After a close approach the robot stands inside the clearance margin: back out, along
-      // its heading, to the nearest clear point behind it (or turn away first if there is none).
+      // its heading, to the nearest clear point behind it (else ahead of it; else turn away
+      // first).
       const Eigen::Vector2d back(-std::cos(pose.z()), -std::sin(pose.z()));
       double distance = 0.0;
       for (double d = 0.05; d <= 0.8 + 1e-9; d += 0.05) {
@@ -393,8 +394,19 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
           break;
         }
       }
+      // None behind (a robot that starts inside the margin with its back to the wall): the
+      // nearest clear point ahead.
+      double ahead = 0.0;
+      for (double d = 0.05; distance <= 0.0 && d <= 0.8 + 1e-9; d += 0.05) {
+        if (planner_->IsClear(pose.head<2>() - d * back)) {
+          ahead = d + 0.03;
+          break;
+        }
+      }
       if (distance > 0.0) {
         Drive({Forward(-distance / odometry_scale_)});
+      } else if (ahead > 0.0) {
+        Drive({Forward(ahead / odometry_scale_)});
       } else {
         Drive({Turn(180.0), Forward(0.3 / odometry_scale_)});
       }

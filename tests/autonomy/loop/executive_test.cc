@@ -228,6 +228,25 @@ TEST(Executive, AKnockIsJudgedByWhereTheBallCameDown) {
   EXPECT_GE(r.points - r.points_start, 10);
 }
 
+// A robot whose start lies inside the planner's clearance margin with its back to the wall
+// (the V5-class robot on High Stakes' tiles) cannot back out of it: it drives out ahead, and
+// its first navigation is planned (before, it reversed into the wall and no plan could start).
+TEST(Executive, ARobotStartingInsideTheMarginDrivesOutAhead) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("high_stakes");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  MatchSetup setup;
+  setup.strategy = "planner";
+  const MatchResult r = RunMatch(season, robot, setup, 1);
+  int navigations = 0, reached = 0;
+  for (const TimelineEntry& t : r.timeline) {
+    if (t.action != "NAVIGATE") continue;
+    ++navigations;
+    reached += t.ok;
+  }
+  EXPECT_GT(navigations, 0);
+  EXPECT_GT(reached, 0);
+}
+
 // The robot and its strategy are told the season as its file has it; only the simulator
 // knows where this seed's jitter put the objects (the scripted route plans from the nominal
 // spots, as a team's would).
