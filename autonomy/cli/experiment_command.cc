@@ -376,7 +376,8 @@ int RunRobustnessTable(const RobustnessArgs& args, uint64_t seed) {
       "it has one), one filter step per %.2f s; each of the season's %zu markers its camera sees "
       "is measured (1 px on the centre, its depth sigma on the depth; ids known, no occlusion); "
       "%d runs from seed %llu; both filters told the `told` robot file's odometry model and "
-      "camera\n",
+      "camera: MRPT one range sigma (the RMS of the camera's depth sigma over its range), slamo "
+      "each measurement's (the depth sigma at the depth read), as a match's vision gives it\n",
       args.season.c_str(), sim_options.start.x_m, sim_options.start.y_m, sim_options.step_s,
       markers, runs, static_cast<unsigned long long>(seed));
   std::printf("%-14s %-14s %-6s %16s %10s %10s %9s %12s\n", "data", "told", "filter",
@@ -395,7 +396,7 @@ int RunRobustnessTable(const RobustnessArgs& args, uint64_t seed) {
   for (const SimRobotRow& row : sim_rows) {
     std::printf(
         "%s told %s: %.0f steps, %.1f m, %.2f markers seen a step, heading from %s; told range "
-        "sd %.4f m, bearing sd %.3f deg, max range %.2f m\n",
+        "sd %.4f m (MRPT), bearing sd %.3f deg, max range %.2f m\n",
         row.robots.data_robot.c_str(), row.robots.told_robot.c_str(), row.steps, row.distance_m,
         row.measurements_per_step, row.gyro ? "the inertial sensor" : "the encoders",
         row.range_sigma_m, row.bearing_sigma_rad * 180.0 / M_PI, row.max_range_m);

@@ -289,7 +289,14 @@ SimRobotLog SimulateRobotLog(const field::SeasonConfig& season, const field::Rob
       mapping::RangeBearing z;
       z.range_m = rb.x();
       z.bearing_rad = rb.y();
-      z.covariance = r;
+      // slamo is told each measurement's own covariance, as a match's vision gives it: the told
+      // camera's depth sigma at the depth read (MRPT's 2D filter takes one sigma, the RMS).
+      if (options.per_measurement_sigma) {
+        const double sigma_depth = platform::DepthSigmaM(told.camera, depth);
+        z.covariance = Eigen::Vector2d(sigma_depth * sigma_depth, r(1, 1)).asDiagonal();
+      } else {
+        z.covariance = r;
+      }
       z.id = static_cast<int>(i);
       seen.push_back(z);
     }

@@ -79,6 +79,9 @@ struct SimRobotOptions {
   platform::Pose2D start{-1.2, -1.2, 0.0};
   double step_s = 0.1;          // simulated time per filter step
   double pixel_sigma_px = 1.0;  // noise of a marker's centre in the image
+  // true: each measurement carries the told camera's depth sigma at its depth (slamo's filter
+  // uses it, as in a match); false: the one RMS sigma MRPT's filter is told.
+  bool per_measurement_sigma = true;
 };
 
 // Which robot drives, and whose noise both filters are told (robot names or files).

@@ -12,6 +12,7 @@
 #include "mapping/ekf_slam.h"
 #include "mapping/metrics.h"
 #include "mapping/replay_log.h"
+#include "platform/camera_geometry.h"
 
 namespace slamo::autonomy {
 namespace {
@@ -107,7 +108,9 @@ TEST(RobustnessSimTest, BothFiltersAreToldTheToldRobotsNoise) {
   const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
   const field::RobotConfig v5 = field::LoadRobotConfig("v5_drivetrain");
   const field::RobotConfig thesis = field::LoadRobotConfig("thesis_robot");
-  const SimRobotLog log = SimulateRobotLog(season, v5, thesis, SimRobotOptions{}, 2);
+  SimRobotOptions one_sigma;
+  one_sigma.per_measurement_sigma = false;
+  const SimRobotLog log = SimulateRobotLog(season, v5, thesis, one_sigma, 2);
   const mapping::MotionNoise motion = mapping::MotionNoiseFor(thesis.odometry_noise);
   const auto [range_sigma, bearing_sigma] = ToldSensorSigmas(thesis.camera, 1.0);
   // The Kinect's depth sigma, 1.0-3.6 mm over 0.5-4.5 m; one pixel over 365.456 px.
@@ -126,6 +129,34 @@ TEST(RobustnessSimTest, BothFiltersAreToldTheToldRobotsNoise) {
       EXPECT_EQ(z.covariance(1, 1), bearing_sigma * bearing_sigma);
     }
   }
+}
+
+TEST(RobustnessSimTest, EachMeasurementCarriesTheToldCamerasDepthSigmaAtItsDepth) {
+  // As a match's vision gives them: the V5 file's D435 depth sigma (0.005 d^2) grows with the
+  // depth read, so far markers carry a wider range variance than near ones, and the RMS sigma
+  // MRPT's filter is told lies between them. The bearing's is one pixel over the focal length.
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  const field::RobotConfig v5 = field::LoadRobotConfig("v5_drivetrain");
+  const SimRobotLog log = SimulateRobotLog(season, v5, v5, SimRobotOptions{}, 2);
+  const auto [range_sigma, bearing_sigma] = ToldSensorSigmas(v5.camera, 1.0);
+  double nearest = 1e9, farthest = 0.0, near_variance = 0.0, far_variance = 0.0;
+  int n = 0;
+  for (const PeerStep& step : log.scenario.steps) {
+    for (const mapping::RangeBearing& z : step.measurements) {
+      ++n;
+      EXPECT_EQ(z.covariance(1, 1), bearing_sigma * bearing_sigma);
+      EXPECT_EQ(z.covariance(0, 1), 0.0);
+      if (z.range_m < nearest) nearest = z.range_m, near_variance = z.covariance(0, 0);
+      if (z.range_m > farthest) farthest = z.range_m, far_variance = z.covariance(0, 0);
+    }
+  }
+  ASSERT_GT(n, 100);
+  ASSERT_GT(farthest, nearest + 1.0);
+  EXPECT_LT(near_variance, range_sigma * range_sigma);
+  EXPECT_GT(far_variance, range_sigma * range_sigma);
+  // At the farthest marker the sigma is the table's at about its depth: within its 0.3-4 m.
+  EXPECT_GT(std::sqrt(far_variance), platform::DepthSigmaM(v5.camera, 0.5 * farthest));
+  EXPECT_LE(std::sqrt(far_variance), platform::DepthSigmaM(v5.camera, v5.camera.max_range_m));
 }
 
 TEST(RobustnessSimTest, TheWrittenLogReplaysTheSameSteps) {
@@ -174,9 +205,10 @@ TEST(RobustnessSimTest, TheWrittenLogReplaysTheSameSteps) {
 
 TEST(RobustnessSimTest, SlamoMapsTheSecondRobotWhetherToldItsNoiseOrTheThesisRobots) {
   // Seeds 1-3, as `slamo experiment robustness --runs 3` prints them. Measured: told its own
-  // file, landmark RMSE 0.0165 m, ATE 0.0147 m, mean NEES 3.7; told the thesis robot's (whose
-  // Kinect's depth sigma is a sixteenth of the D435's), 0.0104 m, 0.0157 m and 1.7, where MRPT's
-  // filter on the same steps is 4x worse and overconfident (0.041 m, 0.051 m, NEES 111).
+  // file (each measurement's depth sigma at its depth), landmark RMSE 0.0076 m, ATE 0.0096 m,
+  // mean NEES 2.3, where MRPT's filter, told one sigma, is at 0.0160 m and 0.0146 m; told the
+  // thesis robot's (whose Kinect's depth sigma is a sixteenth of the D435's), 0.0111 m, 0.0152 m
+  // and 2.6, where MRPT's filter is 4x worse and overconfident (0.041 m, 0.051 m, NEES 111).
   const std::vector<SimRobotRow> rows = RunSimRobotRows(
       SimRobotOptions{}, {{"v5_drivetrain", "v5_drivetrain"}, {"v5_drivetrain", "thesis_robot"}}, 3,
       1, nullptr);
@@ -192,6 +224,9 @@ TEST(RobustnessSimTest, SlamoMapsTheSecondRobotWhetherToldItsNoiseOrTheThesisRob
     EXPECT_LT(row.slamo.mean_nees, 18.7);  // twice the top of one step's 95 % band
     EXPECT_LT(row.slamo.rejected_fraction, 0.02);
   }
+  const SimRobotRow& told_own = rows[0];
+  EXPECT_LE(told_own.slamo.landmark_rmse_m, told_own.mrpt.landmark_rmse_m);
+  EXPECT_LE(told_own.slamo.ate_m, told_own.mrpt.ate_m);
   const SimRobotRow& told_thesis = rows[1];
   EXPECT_LT(told_thesis.slamo.landmark_rmse_m, 0.5 * told_thesis.mrpt.landmark_rmse_m);
   EXPECT_LT(told_thesis.slamo.ate_m, 0.5 * told_thesis.mrpt.ate_m);
