@@ -65,8 +65,8 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   // Objects rest on the floor or on one another, so the top of the blob lies at a whole
   // number of object heights (a robot's bumper, 0.02-0.14 m, does not for rings or blocks).
   {
-    const size_t top_rank = heights.size() - 1 - static_cast<size_t>(options.trim_fraction *
-                                                                     (heights.size() - 1));
+    const size_t top_rank =
+        heights.size() - 1 - static_cast<size_t>(options.trim_fraction * (heights.size() - 1));
     std::nth_element(heights.begin(), heights.begin() + top_rank, heights.end());
     const double top = heights[top_rank];
     if (std::round(top) < 1.0 || std::abs(top - std::round(top)) > options.top_tolerance)
