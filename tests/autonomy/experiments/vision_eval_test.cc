@@ -56,6 +56,7 @@ TEST(VisionEvalTest, StarsAreFoundWholeOnlyWithTheSizeRule) {
   };
   VisionEvalOptions without;
   without.detect.extent_margin_px = -1e9;
+  without.detect.split_by_size = false;  // the split by size keeps them whole too
   const std::vector<VisionMethodScore> with_rule = Scores("starstruck", 10, 1, false);
   const std::vector<VisionMethodScore> without_rule = Scores("starstruck", 10, 1, false, without);
   ASSERT_EQ(with_rule.at(0).name, "threshold+defects");
