@@ -295,6 +295,35 @@ bool FitOnFloor(const CameraModel& camera, const std::vector<TargetKind>& kinds,
   return d->measurement.has_value();
 }
 
+// The extent separation by size uses for a colour's kinds: none when a kind's size is unknown,
+// or when its round kinds differ in size (a buckyball beside a large ball). Without round
+// kinds the largest kind's extent, so that no one object is ever cut; `kind`: the kind whose
+// width it is.
+std::optional<ObjectExtent> SizeExtentOf(const std::vector<TargetKind>& kinds,
+                                         const DetectOptions& options, const TargetKind** kind) {
+  if (kinds.empty()) return std::nullopt;
+  const bool all_round =
+      std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
+  const bool none_round =
+      std::none_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
+  if (!all_round && !none_round) return std::nullopt;
+  ObjectExtent extent;
+  double widest_m = 0.0;
+  for (const TargetKind& k : kinds) {
+    if (k.radius_m <= 0.0 || k.centre_height_m <= 0.0) return std::nullopt;
+    if (all_round && std::abs(k.radius_m - kinds[0].radius_m) > 0.1 * kinds[0].radius_m)
+      return std::nullopt;
+    const double reach_m = 2.0 * k.radius_m * options.size_tolerance_horizontal;
+    if (reach_m > widest_m) widest_m = reach_m, *kind = &k;
+    extent.height_m = std::max(extent.height_m, 2.0 * k.centre_height_m);
+    extent.max_stack = std::max(extent.max_stack, k.max_stack);
+  }
+  extent.width_m = 2.0 * (*kind)->radius_m;
+  extent.horizontal_limit = widest_m / extent.width_m;
+  extent.vertical_limit = options.size_tolerance_vertical;
+  return extent;
+}
+
 std::vector<TargetKind> KindsOf(const DetectorSetup& setup, const std::string& colour) {
   std::vector<TargetKind> out;
   for (const TargetKind& k : setup.kinds) {
@@ -434,6 +463,10 @@ DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
       // blocks seen from a low camera are flat shapes.
       k.min_circularity = round ? 0.6 : 0.3;
       k.round = round;
+      // The tallest stack of this type the season file places (High Stakes' corner rings).
+      for (const field::ObjectPlacement& p : season.objects) {
+        if (p.type == type.name) k.max_stack = std::max(k.max_stack, p.stack_size);
+      }
       k.centre_height_m = type.height_m / 2.0;
       setup.kinds.push_back(k);
     }
@@ -557,11 +590,13 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       // away at a fixed size, which erased far balls in the thesis).
       double expected_radius_px = 0.0;
       double largest_extent_px = 0.0;  // the widest any one kind of this colour can look here
+      double blob_depth_m = 0.0;       // corrected median depth (0: none)
       if (have_depth) {
         const double raw =
             MedianDepthMm(depth_mm(window), blob_mask, cv::Rect(cv::Point(), window.size()));
         if (raw > 0.0) {
           const double z = setup.camera->CorrectDepthM(raw);
+          blob_depth_m = z;
           for (const TargetKind& k : kinds) {
             largest_extent_px = std::max(
                 largest_extent_px, focal * std::hypot(2.0 * k.radius_m, 2.0 * k.centre_height_m) /
@@ -604,10 +639,33 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       const bool one_object = none_round && largest_extent_px > 0.0 &&
                               box.width <= largest_extent_px + options.extent_margin_px &&
                               box.height <= largest_extent_px + options.extent_margin_px;
-      const bool convex = one_object || blob_area >= options.single_object_solidity *
-                                                         ConvexHullArea(blob, blob_box);
+      // With depth, objects of a known size are split by it: every blob of a colour with no
+      // round kind (rings, stacks, blocks), and piles of round objects of one size.
+      const TargetKind* size_kind = nullptr;
+      std::optional<ObjectExtent> size_extent;
+      if (options.split_by_size && blob_depth_m > 0.0) {
+        size_extent = SizeExtentOf(kinds, options, &size_kind);
+        if (size_extent && all_round) {
+          const double metres_per_px = blob_depth_m / focal;
+          const double object_area_m2 = M_PI * size_kind->radius_m * size_kind->radius_m;
+          if (blob_area * metres_per_px * metres_per_px < options.pile_area_ratio * object_area_m2)
+            size_extent.reset();
+        }
+      }
+      SizeSplitResult sized;
+      if (size_extent) {
+        sized = SplitBySize(blob_mask, depth_mm(window), window.tl(), *setup.camera, *size_extent,
+                            options.size_split);
+        if (sized.objects > 1) ++st.split_by_size;
+      }
+      const bool convex =
+          sized.objects == 1 ||
+          (sized.objects == 0 && (one_object || blob_area >= options.single_object_solidity *
+                                                                 ConvexHullArea(blob, blob_box)));
       SeparationResult separated;
-      if (convex) {
+      if (sized.objects > 1) {
+        separated.pieces = std::move(sized.pieces);
+      } else if (convex) {
         std::vector<cv::Point> shifted = blob;
         for (cv::Point& p : shifted) p -= window.tl();
         separated.pieces.push_back(std::move(shifted));
@@ -630,6 +688,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         separated = SeparateTouching(blob_mask, options.separation, options.separation_options);
       }
       const bool split = separated.pieces.size() > 1;
+      const bool by_size = sized.objects > 1;
       // Left whole: the one piece is the blob's own outline (convex, or nothing to cut).
       const bool whole =
           convex ||
@@ -640,7 +699,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       // The blob's own outline (not cuts, not the image border): where arcs of objects show.
       // Not needed for a blob left whole: every point of its piece is on the outline.
       cv::Mat outline;
-      if (all_round && !whole) {
+      if (all_round && !whole && !by_size) {
         outline = cv::Mat(window.size(), CV_8UC1, cv::Scalar(0));
         for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
         cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
@@ -651,6 +710,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         Detection d;
         d.colour = colour.name;
         d.split = split;
+        d.sized = by_size;
         d.area_px = cv::contourArea(piece);
         if (d.area_px < options.min_area_px) {
           ++st.rejected_small;
@@ -659,7 +719,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         const double perimeter = cv::arcLength(piece, true);
         d.circularity = perimeter > 0.0 ? 4.0 * M_PI * d.area_px / (perimeter * perimeter) : 0.0;
         d.box = cv::boundingRect(piece);
-        if (all_round) {
+        if (all_round && !by_size) {
           // Round objects: a circle through the visible arcs of the outline gives the centre
           // and radius even when a cut, another object or the image border hides part of it.
           std::vector<cv::Point> arc;
@@ -684,7 +744,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               std::clamp(1.0 - fit->rms / (options.max_arc_rms_ratio * fit->radius), 0.0, 1.0) *
               std::min(1.0, fit->coverage_deg / 360.0 + 0.25);
         } else {
-          if (d.circularity < min_circularity) {
+          if (!by_size && d.circularity < min_circularity) {
             ++st.rejected_shape;
             continue;
           }
@@ -724,8 +784,10 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             d.kind = on_floor.kind;
             ++st.without_depth;
           } else {
+            // A piece split off by size is an object: only its kind is in question.
             const TargetKind* best = nullptr;
-            double best_ratio = options.size_tolerance;
+            double best_ratio =
+                by_size ? std::numeric_limits<double>::infinity() : options.size_tolerance;
             for (const TargetKind& k : kinds) {
               if (k.radius_m <= 0.0) continue;
               const double expected =

@@ -17,6 +17,7 @@
 #include "vision/colour_classes.h"
 #include "vision/measurement.h"
 #include "vision/separation.h"
+#include "vision/size_split.h"
 
 namespace slamo::vision {
 
@@ -37,6 +38,14 @@ struct DetectOptions {
   // With depth, a blob of a colour with no round kind that is at most one object's apparent
   // diagonal wide and tall (plus this, px: the outline's pixel quantisation) is not separated.
   double extent_margin_px = 2.0;
+  // With depth, separation by the objects' known size (vision/size_split.h): for colours with
+  // no round kind every blob (a ring is never cut, a stack of rings or blocks is split one by
+  // one); for round kinds of one size, piles: blobs larger than pile_area_ratio objects.
+  bool split_by_size = true;
+  double size_tolerance_horizontal = 1.25;  // a group fits one object up to this x its width
+  double size_tolerance_vertical = 1.3;     // ... and this x its height
+  double pile_area_ratio = 4.0;             // x the apparent area of one object
+  SizeSplitOptions size_split;
   // Round kinds: a circle fitted to the blob's outline (not the image border or a cut) must
   // fit within this x its radius (rms) and cover at least this much of the circle.
   double max_arc_rms_ratio = 0.1;
@@ -62,6 +71,8 @@ struct TargetKind {
   double centre_height_m = 0.0;      // the centre above the floor, resting on it (0: unknown)
   double min_circularity = 0.6;      // 4 pi A / P^2 of an unoccluded view (flat kinds)
   bool round = true;                 // looks like a disc from anywhere: judged by a circle fit
+  int max_stack = 1;                 // most of them one on top of another (the season's
+                                     // tallest stack placed)
 };
 
 struct DetectorSetup {
@@ -93,6 +104,7 @@ struct Detection {
   double score = 0.0;  // circularity x fill of the enclosing circle, 0..1
   std::vector<cv::Point> contour;
   bool split = false;  // came from separating a blob of touching objects
+  bool sized = false;  // ... by the objects' known size (vision/size_split.h)
   std::optional<Measurement> measurement;
 };
 
@@ -102,6 +114,7 @@ struct DetectStats {
   int rejected_small = 0;
   int rejected_shape = 0;
   int rejected_size = 0;
+  int split_by_size = 0;  // blobs separated by the objects' known size
   int without_depth = 0;  // kept, but no range: no valid depth on them (or, without a depth
                           // image, no kind resting on the floor fits their size)
 };

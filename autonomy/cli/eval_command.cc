@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 
 #include "autonomy/cli/commands.h"
 #include "autonomy/cli/options.h"
@@ -24,6 +25,8 @@ struct EvalArgs {
   bool no_depth = false;
   double max_range_m = 3.0;
   double pose_sigma_m = 0.05;
+  std::vector<int> pile;  // MIN,MAX
+  bool no_size_split = false;
 };
 
 int RunVision(const EvalArgs& args) {
@@ -38,6 +41,13 @@ int RunVision(const EvalArgs& args) {
   options.depth = !args.no_depth;
   options.max_range_m = args.max_range_m;
   options.pose_sigma_m = args.pose_sigma_m;
+  options.detect.split_by_size = !args.no_size_split;
+  if (!args.pile.empty()) {
+    if (args.pile[0] > args.pile[1])
+      throw std::invalid_argument("--pile MIN,MAX: MIN must not exceed MAX");
+    options.pile_min = args.pile[0];
+    options.pile_max = args.pile[1];
+  }
   if (!args.pictures.empty()) std::filesystem::create_directories(args.pictures);
   const auto progress = [](int done, int total) {
     if (done % 10 == 0 || done == total) std::fprintf(stderr, "\rframe %d/%d", done, total);
@@ -51,6 +61,7 @@ int RunVision(const EvalArgs& args) {
       args.no_depth ? ", no depth" : "", args.frames, static_cast<unsigned long long>(args.seed),
       options.max_range_m, options.min_visible_px, options.pose_sigma_m);
   std::fputs(FormatVisionTable(scores).c_str(), stdout);
+  std::fputs(FormatPileTable(scores).c_str(), stdout);
   for (const VisionMethodScore& s : scores) {
     if (s.name == args.picture_method) std::fputs(FormatTypeTable(s).c_str(), stdout);
   }
@@ -85,6 +96,16 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
       ->add_option("--pose-sigma", args->pose_sigma_m,
                    "error of the pose the field gate is given, 1 sigma in x and y (m)")
       ->capture_default_str();
+  vision
+      ->add_option("--pile", args->pile,
+                   "MIN,MAX: every view gets a heap of MIN..MAX touching objects of one colour "
+                   "(the season's smallest type); counts of it are scored within 10 %")
+      ->expected(2)
+      ->delimiter(',')
+      ->check(CLI::Range(1, 200));
+  vision->add_flag("--no-size-split", args->no_size_split,
+                   "separate without the objects' known size (the detector before it, for "
+                   "comparison)");
   vision->add_option("--pictures", args->pictures,
                      "write annotated views of the 12 worst frames (detections, misses, false "
                      "and off-field detections) here");

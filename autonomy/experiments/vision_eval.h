@@ -30,6 +30,10 @@ struct VisionEvalOptions {
   int min_visible_px = 40;            // truth objects with fewer visible pixels are not expected
   double min_visible_fraction = 0.5;  // ... nor those showing less of their disc than this
   double touching_fraction = 0.5;     // share of frames where an object is moved against another
+  // Piles: when pile_max > 0, every view gets a heap of pile_min..pile_max touching objects of
+  // the season's smallest type, one colour, on the floor 1-2 m in front of the robot
+  // (platform::AddPile); each method's count of it is scored.
+  int pile_min = 0, pile_max = 0;
   // The field gate's pose: the true pose plus Gaussian error of this sigma (m) in x and y,
   // which the gate is also told.
   double pose_sigma_m = 0.05;
@@ -64,7 +68,13 @@ struct VisionMethodScore {
   int expected_solid = 0, found_solid = 0;
   int expected_semi = 0, found_semi = 0;
   int groups = 0;          // groups of touching same-coloured objects in view
-  int groups_counted = 0;  // ... whose every member was found
+  int groups_counted = 0;  // ... with exactly one detection on each member
+  // Piles (--pile): views with a pile in sight; its visible members (>= min_visible_px
+  // pixels); the method's kept detections of the pile's colour centred on it.
+  int piles = 0;
+  int piles_within_10pct = 0;               // |detections - visible| <= 10 % of visible
+  int pile_visible = 0, pile_detected = 0;  // sums over the piles
+  double pile_abs_error_ratio_sum = 0.0;    // |detections - visible| / visible
   double centre_error_px_sum = 0.0;
   int centre_errors = 0;
   // Distance band (0: < 1 m, 1: 1-2 m, 2: 2-3 m, 3: >= 3 m) -> (sum of errors, count).
@@ -84,6 +94,8 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
 
 // The scores as a table, one row per method.
 std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores);
+// Pile counts per method (empty when no pile was scored).
+std::string FormatPileTable(const std::vector<VisionMethodScore>& scores);
 // One method's scores per object type.
 std::string FormatTypeTable(const VisionMethodScore& score);
 

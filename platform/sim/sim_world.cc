@@ -83,4 +83,72 @@ SimWorld CreateWorld(const SeasonConfig& season, uint64_t seed) {
   return world;
 }
 
+namespace {
+
+// Removes the world's objects within `radius_m` (plus their own radius) of `centre_m` and
+// returns the next free id.
+int ClearAround(const Eigen::Vector2d& centre_m, double radius_m, SimWorld* world) {
+  std::vector<SimObject>& objects = world->objects;
+  objects.erase(std::remove_if(objects.begin(), objects.end(),
+                               [&](const SimObject& o) {
+                                 return (o.center_m.head<2>() - centre_m).norm() <
+                                        radius_m + o.type->size_m / 2.0;
+                               }),
+                objects.end());
+  int next_id = 1;
+  for (const SimObject& o : objects) next_id = std::max(next_id, o.id + 1);
+  return next_id;
+}
+
+}  // namespace
+
+std::vector<int> AddPile(const field::ObjectType& type, const std::string& colour,
+                         const Eigen::Vector2d& centre_m, int count, SimWorld* world) {
+  // Hexagonal packing, spacing one size (touching), the `count` places nearest the centre.
+  const double spacing = type.size_m * 1.001;
+  std::vector<Eigen::Vector2d> places;
+  const int rings = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count)))) + 2;
+  for (int row = -rings; row <= rings; ++row) {
+    for (int column = -rings; column <= rings; ++column) {
+      places.emplace_back((column + 0.5 * (row & 1)) * spacing,
+                          row * spacing * std::sqrt(3.0) / 2.0);
+    }
+  }
+  std::stable_sort(places.begin(), places.end(),
+                   [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+                     return a.squaredNorm() < b.squaredNorm();
+                   });
+  places.resize(std::min<size_t>(places.size(), count));
+  double reach = 0.0;
+  for (const Eigen::Vector2d& p : places) reach = std::max(reach, p.norm() + type.size_m / 2.0);
+  int next_id = ClearAround(centre_m, reach, world);
+  std::vector<int> ids;
+  for (const Eigen::Vector2d& p : places) {
+    SimObject o;
+    o.id = next_id++;
+    o.type = &type;
+    o.colour = colour;
+    o.center_m = Eigen::Vector3d(centre_m.x() + p.x(), centre_m.y() + p.y(), type.height_m / 2.0);
+    world->objects.push_back(o);
+    ids.push_back(o.id);
+  }
+  return ids;
+}
+
+std::vector<int> AddStack(const field::ObjectType& type, const std::string& colour,
+                          const Eigen::Vector2d& centre_m, int count, SimWorld* world) {
+  int next_id = ClearAround(centre_m, type.size_m / 2.0, world);
+  std::vector<int> ids;
+  for (int level = 0; level < count; ++level) {
+    SimObject o;
+    o.id = next_id++;
+    o.type = &type;
+    o.colour = colour;
+    o.center_m = Eigen::Vector3d(centre_m.x(), centre_m.y(), (level + 0.5) * type.height_m);
+    world->objects.push_back(o);
+    ids.push_back(o.id);
+  }
+  return ids;
+}
+
 }  // namespace slamo::platform

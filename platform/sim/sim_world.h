@@ -49,4 +49,15 @@ struct SimWorld {
 // other objects and blocking structures) and picks the lighting from `seed`.
 SimWorld CreateWorld(const field::SeasonConfig& season, uint64_t seed);
 
+// Test scenes for counting (issue 16): objects of one type and colour added to the world,
+// after removing those already where they go; new ids after the world's largest. Returns the
+// new objects' ids.
+// A heap: `count` objects on the floor, touching, packed hexagonally (each the nearest free
+// place to `centre_m`), one layer.
+std::vector<int> AddPile(const field::ObjectType& type, const std::string& colour,
+                         const Eigen::Vector2d& centre_m, int count, SimWorld* world);
+// A stack: `count` objects one on top of the other at `centre_m` (rings on a stake).
+std::vector<int> AddStack(const field::ObjectType& type, const std::string& colour,
+                          const Eigen::Vector2d& centre_m, int count, SimWorld* world);
+
 }  // namespace slamo::platform

@@ -1,0 +1,231 @@
+#include "vision/size_split.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+namespace slamo::vision {
+namespace {
+
+// The extent of `values` between the trim quantiles (values is reordered).
+double TrimmedExtent(std::vector<float>* values, double trim) {
+  if (values->size() < 2) return 0.0;
+  const size_t n = values->size();
+  const size_t lo = static_cast<size_t>(trim * (n - 1)), hi = n - 1 - lo;
+  std::nth_element(values->begin(), values->begin() + lo, values->end());
+  const float low = (*values)[lo];
+  std::nth_element(values->begin(), values->begin() + hi, values->end());
+  return (*values)[hi] - low;
+}
+
+}  // namespace
+
+SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
+                            const CameraModel& camera, const ObjectExtent& extent,
+                            const SizeSplitOptions& options) {
+  SizeSplitResult result;
+  if (mask.empty() || extent.width_m <= 0.0 || extent.height_m <= 0.0) return result;
+  // Points: the blob without its rim, where depth may read what lies behind the object.
+  cv::Mat core = mask;
+  if (options.erode_px > 0) {
+    cv::erode(mask, core, cv::Mat(), cv::Point(-1, -1), options.erode_px);
+    if (cv::countNonZero(core) < 16) core = mask;
+  }
+  std::vector<cv::Point> pixels;
+  std::vector<cv::Vec3f> points;  // robot frame, in units of the object's width and height
+  for (int v = 0; v < core.rows; ++v) {
+    const uint8_t* m = core.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    for (int u = 0; u < core.cols; ++u) {
+      if (!m[u] || !d[u]) continue;
+      const double z = camera.CorrectDepthM(d[u]);
+      if (!(z > 0.0)) continue;
+      const Eigen::Vector3d p =
+          camera.CameraToRobot(camera.BackProject(u + offset.x, v + offset.y, z));
+      pixels.emplace_back(u, v);
+      points.emplace_back(static_cast<float>(p.x() / extent.width_m),
+                          static_cast<float>(p.y() / extent.width_m),
+                          static_cast<float>(p.z() / extent.height_m));
+    }
+  }
+  if (points.size() < 8) return result;
+
+  // Taller than the tallest stack, or flatter than one object: not objects of this size.
+  std::vector<float> heights(points.size());
+  for (size_t i = 0; i < points.size(); ++i) heights[i] = points[i][2];
+  const double height_units = TrimmedExtent(&heights, options.trim_fraction);
+  if (height_units > extent.vertical_limit * std::max(1, extent.max_stack) ||
+      height_units < extent.min_vertical) {
+    return result;
+  }
+  // Objects rest on the floor or on one another, so the top of the blob lies at a whole
+  // number of object heights (a robot's bumper, 0.02-0.14 m, does not for rings or blocks).
+  {
+    const size_t top_rank =
+        heights.size() - 1 - static_cast<size_t>(options.trim_fraction * (heights.size() - 1));
+    std::nth_element(heights.begin(), heights.begin() + top_rank, heights.end());
+    const double top = heights[top_rank];
+    if (std::round(top) < 1.0 || std::abs(top - std::round(top)) > options.top_tolerance)
+      return result;
+  }
+
+  // Objects rest on the floor or on one another: a point's level in a stack is the number of
+  // object heights below it (a top face, at the height of the object it covers, belongs to
+  // that object: hence the slack).
+  const int levels = std::max(1, static_cast<int>(std::ceil(height_units - options.level_slack)));
+  const auto level_of = [&](const cv::Vec3f& q) {
+    return std::clamp(static_cast<int>(std::floor(q[2] - options.level_slack)), 0, levels - 1);
+  };
+  // Per level, the footprint as occupied cells (each object's share by the floor area it
+  // covers, not by its pixels: a face turned to the camera has many, a top face seen at a
+  // grazing angle few); a cell needs two points (a lone rim pixel seeing past is none).
+  std::vector<std::vector<cv::Point2f>> level_points(levels);
+  {
+    std::vector<std::map<std::pair<int, int>, int>> cells(levels);
+    const double cell = options.cell_size;
+    for (const cv::Vec3f& q : points) {
+      ++cells[level_of(q)][{static_cast<int>(std::floor(q[0] / cell)),
+                            static_cast<int>(std::floor(q[1] / cell))}];
+    }
+    for (int level = 0; level < levels; ++level) {
+      for (const auto& [at, count] : cells[level]) {
+        if (count >= 2)
+          level_points[level].emplace_back((at.first + 0.5) * cell, (at.second + 0.5) * cell);
+      }
+    }
+  }
+
+  // Per level, the fewest groups whose footprint each fits one object: the rectangle round
+  // it (turned as it lies: a block at 45 degrees is no wider), between the trim quantiles.
+  std::vector<cv::Point2f> footprint;
+  std::vector<float> xs, ys;
+  const auto fits = [&](const std::vector<cv::Point2f>& pts, const std::vector<int>& labels,
+                        int k) {
+    for (int c = 0; c < k; ++c) {
+      xs.clear();
+      ys.clear();
+      for (size_t i = 0; i < pts.size(); ++i) {
+        if (labels[i] == c) xs.push_back(pts[i].x), ys.push_back(pts[i].y);
+      }
+      if (xs.size() < 3) continue;
+      const size_t m = xs.size(), cut = static_cast<size_t>(options.trim_fraction * (m - 1));
+      std::nth_element(xs.begin(), xs.begin() + cut, xs.end());
+      const float x_lo = xs[cut];
+      std::nth_element(xs.begin(), xs.begin() + (m - 1 - cut), xs.end());
+      const float x_hi = xs[m - 1 - cut];
+      std::nth_element(ys.begin(), ys.begin() + cut, ys.end());
+      const float y_lo = ys[cut];
+      std::nth_element(ys.begin(), ys.begin() + (m - 1 - cut), ys.end());
+      const float y_hi = ys[m - 1 - cut];
+      footprint.clear();
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const cv::Point2f& q = pts[i];
+        if (labels[i] == c && q.x >= x_lo && q.x <= x_hi && q.y >= y_lo && q.y <= y_hi)
+          footprint.push_back(q);
+      }
+      if (footprint.size() < 3) continue;
+      const cv::RotatedRect rect = cv::minAreaRect(footprint);
+      if (std::max(rect.size.width, rect.size.height) > extent.horizontal_limit) return false;
+    }
+    return true;
+  };
+  std::vector<std::vector<cv::Point2f>> level_centres(levels);
+  int k_total = 0;
+  for (int level = 0; level < levels; ++level) {
+    const std::vector<cv::Point2f>& pts = level_points[level];
+    if (static_cast<int>(pts.size()) < options.min_level_points) continue;
+    std::vector<int> labels(pts.size(), 0);
+    cv::Point2f mean(0, 0);
+    for (const cv::Point2f& q : pts) mean += q;
+    std::vector<cv::Point2f> centres{mean * (1.0f / pts.size())};
+    const cv::Mat data(static_cast<int>(pts.size()), 2, CV_32F,
+                       const_cast<cv::Point2f*>(pts.data()));
+    const int most = std::min(options.max_objects - k_total, static_cast<int>(pts.size()));
+    int k = 1;
+    while (!fits(pts, labels, k) && k < most) {
+      ++k;
+      cv::Mat fit_labels, fit_centres;
+      cv::theRNG().state = 0x5eed + k;  // k-means++ seeding: the same groups for the same blob
+      cv::kmeans(data, k, fit_labels,
+                 cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
+                                  options.kmeans_iterations, 1e-3),
+                 1, cv::KMEANS_PP_CENTERS, fit_centres);
+      for (size_t i = 0; i < pts.size(); ++i) labels[i] = fit_labels.at<int>(static_cast<int>(i));
+      centres.assign(k, cv::Point2f());
+      for (int c = 0; c < k; ++c) centres[c] = fit_centres.at<cv::Point2f>(c);
+    }
+    level_centres[level] = centres;
+    k_total += k;
+    if (k_total >= options.max_objects) break;
+  }
+  if (k_total == 0) return result;
+  // The top level is seen from above (the camera is higher than any stack): each of its
+  // objects shows a top face or cap, not just a thin upright face (a wall, a poster, a bar).
+  for (int level = levels - 1; level >= 0; --level) {
+    const std::vector<cv::Point2f>& centres = level_centres[level];
+    if (centres.empty()) continue;
+    std::vector<std::vector<cv::Point2f>> groups(centres.size());
+    for (const cv::Point2f& q : level_points[level]) {
+      size_t best = 0;
+      for (size_t c = 1; c < centres.size(); ++c) {
+        if (cv::norm(q - centres[c]) < cv::norm(q - centres[best])) best = c;
+      }
+      groups[best].push_back(q);
+    }
+    for (const std::vector<cv::Point2f>& g : groups) {
+      if (g.size() < 3) continue;
+      const cv::RotatedRect rect = cv::minAreaRect(g);
+      // Cells are points at their centres: one cell more across.
+      if (std::min(rect.size.width, rect.size.height) + options.cell_size < options.min_top_depth)
+        return result;
+    }
+    break;
+  }
+  result.objects = k_total;
+
+  // Every point to the nearest centre of its level (of any level when its own has none);
+  // each group's pixels, grown back over the rim.
+  std::vector<std::pair<int, cv::Point2f>> all_centres;  // (level, centre)
+  for (int level = 0; level < levels; ++level) {
+    for (const cv::Point2f& c : level_centres[level]) all_centres.emplace_back(level, c);
+  }
+  const int k = static_cast<int>(all_centres.size());
+  std::vector<cv::Mat> group_masks(k);
+  for (cv::Mat& g : group_masks) g = cv::Mat::zeros(mask.size(), CV_8UC1);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const int level = level_of(points[i]);
+    const bool own_level = !level_centres[level].empty();
+    int best = 0;
+    float best_d2 = std::numeric_limits<float>::infinity();
+    for (int c = 0; c < k; ++c) {
+      if (own_level && all_centres[c].first != level) continue;
+      const float dx = points[i][0] - all_centres[c].second.x;
+      const float dy = points[i][1] - all_centres[c].second.y;
+      const float dz = own_level ? 0.0f : static_cast<float>(level - all_centres[c].first);
+      const float d2 = dx * dx + dy * dy + dz * dz;
+      if (d2 < best_d2) best_d2 = d2, best = c;
+    }
+    group_masks[best].at<uint8_t>(pixels[i]) = 255;
+  }
+  const cv::Mat grow = cv::getStructuringElement(
+      cv::MORPH_ELLIPSE, cv::Size(2 * options.erode_px + 3, 2 * options.erode_px + 3));
+  for (cv::Mat& g : group_masks) {
+    cv::morphologyEx(g, g, cv::MORPH_CLOSE, grow);
+    cv::dilate(g, g, grow);
+    g &= mask;
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(g, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    if (contours.empty()) continue;
+    const auto largest = std::max_element(
+        contours.begin(), contours.end(),
+        [](const auto& a, const auto& b) { return cv::contourArea(a) < cv::contourArea(b); });
+    result.pieces.push_back(std::move(*largest));
+  }
+  return result;
+}
+
+}  // namespace slamo::vision

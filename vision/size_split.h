@@ -1,0 +1,64 @@
+// Touching objects of a known size split by that size (issue 16, items 3 and 4): the blob's
+// pixels, back-projected with their depth into the robot frame (level with the floor), are
+// sorted into stack levels by their height (objects rest on the floor or on one another), and
+// each level's footprint on the floor is clustered (k-means) into the fewest groups that each
+// fit one object's width. A ring is one group however concave its outline; a stack of N
+// rings is N groups, one per band of the ring's thickness; blocks side by side, one behind
+// another or on top of each other are one group each; a pile is as many groups as its
+// visible objects. Pure function of the mask and depth.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "vision/camera_model.h"
+
+namespace slamo::vision {
+
+// One object's extent, from the season file's object type.
+struct ObjectExtent {
+  double width_m = 0.0;   // horizontal: a diameter, or a box's edge
+  double height_m = 0.0;  // vertical, resting on the floor (a ring's thickness)
+  // A group fits one object when the rectangle round its footprint on the floor (turned as
+  // it lies) is at most this x width_m on its long side ...
+  double horizontal_limit = 1.25;
+  double vertical_limit = 1.3;  // a blob is at most max_stack x this x height_m tall
+  // A blob taller than this x height_m x vertical_limit is not a stack of these objects (a
+  // structure, a robot's bumper standing up): not split (objects 0).
+  int max_stack = 1;
+  // ... and a blob flatter than this x height_m is not these objects either (floor markings,
+  // a low bar of the same colour).
+  double min_vertical = 0.7;
+};
+
+struct SizeSplitOptions {
+  int max_objects = 40;         // a blob is never split into more groups than this
+  double cell_size = 0.1;       // footprint cells, x the object's width
+  double trim_fraction = 0.03;  // extents are taken between these quantiles (depth outliers
+                                // at the rim, where a pixel sees past the object)
+  int erode_px = 1;             // the blob's rim is left out of the clustering
+  int kmeans_iterations = 12;
+  // A point up to this x the object's height above a level's top is still on it (its top
+  // face, with depth noise).
+  double level_slack = 0.1;
+  // The blob's top (its 97th percentile) within this x the object's height of a whole number
+  // of heights; each object of the top level at least min_top_depth widths deep on the floor.
+  double top_tolerance = 0.2;
+  double min_top_depth = 0.35;
+  int min_level_points = 4;  // a stack level with fewer footprint cells has no objects of its own
+};
+
+struct SizeSplitResult {
+  std::vector<std::vector<cv::Point>> pieces;  // one external contour per object, mask pixels
+  int objects = 0;  // groups found (0: no depth on the blob, or taller than a stack; pieces
+                    // then holds nothing)
+};
+
+// `mask`: CV_8UC1, non-zero on the blob; `depth_mm`: CV_16UC1 raw readings of the same size;
+// `offset`: where the mask's (0, 0) lies in the full image (for the camera's intrinsics).
+SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
+                            const CameraModel& camera, const ObjectExtent& extent,
+                            const SizeSplitOptions& options = {});
+
+}  // namespace slamo::vision
