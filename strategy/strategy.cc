@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
@@ -64,6 +65,7 @@ class Base : public Strategy {
 
   Action Next(const Belief& b, const StrategyContext& c) final {
     LearnDuration(b);
+    score_stages_.clear();  // the planner's map may have changed since the last decision
     Action a = Choose(b, c);
     pending_ = a;
     pending_start_s_ = b.now_s;
@@ -190,6 +192,17 @@ class Base : public Strategy {
     return true;
   }
 
+  // ScoreStages for goal g and an object of radius r. They depend only on the season, the robot
+  // and the planner's map, none of which changes during a decision, while a decision asks for
+  // them for every candidate cycle: computed once per decision (Next() forgets them).
+  const std::vector<Eigen::Vector3d>& StagesFor(const StrategyContext& c, int g, double r) const {
+    const auto key = std::make_pair(g, r);
+    auto it = score_stages_.find(key);
+    if (it == score_stages_.end())
+      it = score_stages_.emplace(key, ScoreStages(c, g, r, options_.approach_margin_m)).first;
+    return it->second;
+  }
+
   // The goals an object scores in, with their best staging pose from `from` and the time to
   // get there and release.
   struct GoalChoice {
@@ -213,7 +226,7 @@ class Base : public Strategy {
       // release still lands in the zone: only wider ones block the approach.
       const double blocking =
           c.season->goals[g].kind == field::GoalKind::kZone ? c.robot->width_m : 0.0;
-      for (const Eigen::Vector3d& stage : ScoreStages(c, g, r, options_.approach_margin_m)) {
+      for (const Eigen::Vector3d& stage : StagesFor(c, g, r)) {
         if (failed_targets_.count(Key(stage))) continue;
         if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except, blocking)) continue;
         const std::optional<double> t = c.travel_time_s(from, stage);
@@ -600,6 +613,7 @@ class Base : public Strategy {
   std::map<long, int> failed_targets_;
   std::map<long, int> looked_;
   std::set<int> knocked_;
+  mutable std::map<std::pair<int, double>, std::vector<Eigen::Vector3d>> score_stages_;
   bool surveyed_ = false;
   std::optional<Action> pending_;  // the last action chosen, and when
   double pending_start_s_ = 0.0;
