@@ -99,11 +99,25 @@ bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double leng
     const double yaw = st.yaw_deg * kPi / 180.0;
     const Near n{centre,        cylinder,          st.radius_m,      std::cos(yaw),
                  std::sin(yaw), st.size_m.x / 2.0, st.size_m.y / 2.0};
+    if (!cylinder) {
+      // A long box (a barrier) passes the test above from far along its length: in its own
+      // frame the footprint's points lie within `reach` of the pose along each axis.
+      const Eigen::Vector2d d = Eigen::Vector2d(pose.x_m, pose.y_m) - centre;
+      if (std::abs(n.cos_yaw * d.x() + n.sin_yaw * d.y()) > n.half_x + reach ||
+          std::abs(-n.sin_yaw * d.x() + n.cos_yaw * d.y()) > n.half_y + reach) {
+        continue;
+      }
+    }
     if (count < 16) {
       near[count++] = n;
     } else {
       more.push_back(n);
     }
+  }
+  const double half = season.HalfSize();
+  // Nothing within reach and the footprint well inside the perimeter: every point is free.
+  if (count == 0 && std::abs(pose.x_m) + reach < half && std::abs(pose.y_m) + reach < half) {
+    return true;
   }
   const auto inside = [](const Near& n, const Eigen::Vector2d& p) {
     const Eigen::Vector2d d = p - n.centre;
@@ -116,7 +130,6 @@ bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double leng
   const double s = std::sin(pose.theta_rad);
   // Sample the footprint's outline and centre line densely enough for the thinnest posts.
   const double step = 0.02;
-  const double half = season.HalfSize();
   const int nx = static_cast<int>(std::ceil(length_m / step));
   const int ny = static_cast<int>(std::ceil(width_m / step));
   for (int i = 0; i <= nx; ++i) {
