@@ -77,11 +77,59 @@ bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p) {
 
 bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double length_m,
                      double width_m, double height_m) {
+  // The structures that block this robot and could reach the footprint (the footprint lies
+  // within its half diagonal of the pose, a structure within its own of its centre; the
+  // millimetre covers rounding), each with its rotation worked out once: the same test as
+  // DistanceToStructure(st, p) <= 0 (inside or on the edge), with fewer sines and cosines.
+  struct Near {
+    Eigen::Vector2d centre;
+    bool cylinder;
+    double radius_m, cos_yaw, sin_yaw, half_x, half_y;
+  };
+  Near near[16];
+  std::vector<Near> more;
+  int count = 0;
+  const double reach = 0.5 * std::hypot(length_m, width_m) + 1e-3;
+  for (const Structure& st : season.structures) {
+    if (!BlocksRobot(st, height_m)) continue;
+    const Eigen::Vector2d centre(st.center_m.x, st.center_m.y);
+    const bool cylinder = st.shape == SolidShape::kCylinder;
+    const double extent = cylinder ? st.radius_m : 0.5 * std::hypot(st.size_m.x, st.size_m.y);
+    if ((centre - Eigen::Vector2d(pose.x_m, pose.y_m)).norm() > reach + extent) continue;
+    const double yaw = st.yaw_deg * kPi / 180.0;
+    const Near n{centre,        cylinder,          st.radius_m,      std::cos(yaw),
+                 std::sin(yaw), st.size_m.x / 2.0, st.size_m.y / 2.0};
+    if (!cylinder) {
+      // A long box (a barrier) passes the test above from far along its length: in its own
+      // frame the footprint's points lie within `reach` of the pose along each axis.
+      const Eigen::Vector2d d = Eigen::Vector2d(pose.x_m, pose.y_m) - centre;
+      if (std::abs(n.cos_yaw * d.x() + n.sin_yaw * d.y()) > n.half_x + reach ||
+          std::abs(-n.sin_yaw * d.x() + n.cos_yaw * d.y()) > n.half_y + reach) {
+        continue;
+      }
+    }
+    if (count < 16) {
+      near[count++] = n;
+    } else {
+      more.push_back(n);
+    }
+  }
+  const double half = season.HalfSize();
+  // Nothing within reach and the footprint well inside the perimeter: every point is free.
+  if (count == 0 && std::abs(pose.x_m) + reach < half && std::abs(pose.y_m) + reach < half) {
+    return true;
+  }
+  const auto inside = [](const Near& n, const Eigen::Vector2d& p) {
+    const Eigen::Vector2d d = p - n.centre;
+    if (n.cylinder) return d.norm() - n.radius_m <= 0.0;
+    const double lx = n.cos_yaw * d.x() + n.sin_yaw * d.y();
+    const double ly = -n.sin_yaw * d.x() + n.cos_yaw * d.y();
+    return std::abs(lx) - n.half_x <= 0.0 && std::abs(ly) - n.half_y <= 0.0;
+  };
   const double c = std::cos(pose.theta_rad);
   const double s = std::sin(pose.theta_rad);
   // Sample the footprint's outline and centre line densely enough for the thinnest posts.
   const double step = 0.02;
-  const double half = season.HalfSize();
   const int nx = static_cast<int>(std::ceil(length_m / step));
   const int ny = static_cast<int>(std::ceil(width_m / step));
   for (int i = 0; i <= nx; ++i) {
@@ -91,8 +139,11 @@ bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double leng
       const double ly = -width_m / 2.0 + width_m * j / ny;
       const Eigen::Vector2d p(pose.x_m + c * lx - s * ly, pose.y_m + s * lx + c * ly);
       if (std::abs(p.x()) > half || std::abs(p.y()) > half) return false;
-      for (const Structure& st : season.structures) {
-        if (BlocksRobot(st, height_m) && DistanceToStructure(st, p) <= 0.0) return false;
+      for (int k = 0; k < count; ++k) {
+        if (inside(near[k], p)) return false;
+      }
+      for (const Near& n : more) {
+        if (inside(n, p)) return false;
       }
     }
   }

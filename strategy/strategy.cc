@@ -6,6 +6,8 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
@@ -64,6 +66,9 @@ class Base : public Strategy {
 
   Action Next(const Belief& b, const StrategyContext& c) final {
     LearnDuration(b);
+    // The planner's map may have changed since the last decision.
+    score_stages_.clear();
+    knock_ways_.clear();
     Action a = Choose(b, c);
     pending_ = a;
     pending_start_s_ = b.now_s;
@@ -190,6 +195,17 @@ class Base : public Strategy {
     return true;
   }
 
+  // ScoreStages for goal g and an object of radius r. They depend only on the season, the robot
+  // and the planner's map, none of which changes during a decision, while a decision asks for
+  // them for every candidate cycle: computed once per decision (Next() forgets them).
+  const std::vector<Eigen::Vector3d>& StagesFor(const StrategyContext& c, int g, double r) const {
+    const auto key = std::make_pair(g, r);
+    auto it = score_stages_.find(key);
+    if (it == score_stages_.end())
+      it = score_stages_.emplace(key, ScoreStages(c, g, r, options_.approach_margin_m)).first;
+    return it->second;
+  }
+
   // The goals an object scores in, with their best staging pose from `from` and the time to
   // get there and release.
   struct GoalChoice {
@@ -213,7 +229,7 @@ class Base : public Strategy {
       // release still lands in the zone: only wider ones block the approach.
       const double blocking =
           c.season->goals[g].kind == field::GoalKind::kZone ? c.robot->width_m : 0.0;
-      for (const Eigen::Vector3d& stage : ScoreStages(c, g, r, options_.approach_margin_m)) {
+      for (const Eigen::Vector3d& stage : StagesFor(c, g, r)) {
         if (failed_targets_.count(Key(stage))) continue;
         if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except, blocking)) continue;
         const std::optional<double> t = c.travel_time_s(from, stage);
@@ -260,6 +276,45 @@ class Base : public Strategy {
                                  int frames) const {
     std::vector<Cycle> out;
     if (knocked_.count(o.id) || s.shape != field::SolidShape::kBox) return out;
+    for (const KnockWay& way : KnockWaysFor(c, o, s)) {
+      if (failed_targets_.count(Key(way.stage))) continue;
+      const std::optional<double> t = c.travel_time_s(from, way.stage);
+      if (!t) continue;
+      Cycle cycle;
+      cycle.object = &o;
+      cycle.knock = true;
+      cycle.pick_stage = way.stage;
+      cycle.push_end = way.push_end;
+      cycle.score_stage = way.stage;
+      cycle.goal = way.goal;
+      cycle.seconds = (*t + PushSeconds(c)) * Scale(kDrive) + frames / c.frame_rate_hz;
+      cycle.gain = way.points;  // on top of a structure it lies in no zone
+      // Straight off when the bumper meets it within half its width of its centre.
+      const double pose_var = PoseVarianceAfter(b, frames);
+      const Eigen::Matrix2d cov =
+          o.covariance + Eigen::Matrix2d::Identity() * (pose_var + b.pose_covariance(2, 2) * 0.25);
+      cycle.probability = SuccessProbability(cov, c.robot->width_m / 2.0) * o.confidence;
+      cycle.frames = frames;
+      out.push_back(cycle);
+    }
+    return out;
+  }
+
+  // A way to knock object o off box structure s: the stage to start the run-in from and where
+  // the push ends (headings across the structure), the zone the object lands in and its points.
+  struct KnockWay {
+    Eigen::Vector3d stage, push_end;
+    int goal = -1, points = 0;
+  };
+  // The ways across (at most two), from the season, the robot and the planner's map only: kept
+  // for the decision per object and position, since every candidate cycle asks again (Next()
+  // forgets them).
+  const std::vector<KnockWay>& KnockWaysFor(const StrategyContext& c, const ObjectBelief& o,
+                                            const field::Structure& s) const {
+    const auto key = std::make_tuple(o.id, o.position_m.x(), o.position_m.y(), &s);
+    auto cached = knock_ways_.find(key);
+    if (cached != knock_ways_.end()) return cached->second;
+    std::vector<KnockWay> ways;
     const double r = ObjectRadius(*c.season, o.kind);
     const double yaw = s.yaw_deg * kPi / 180.0 + (s.size_m.x <= s.size_m.y ? 0.0 : kPi / 2.0);
     const double half = c.season->HalfSize();
@@ -299,28 +354,10 @@ class Base : public Strategy {
       const double heading = heading_rad;
       const Eigen::Vector2d stage = *end - options_.push_run_in_m * dir;
       if (!c.is_clear(stage)) continue;
-      const Eigen::Vector3d stage_pose(stage.x(), stage.y(), heading);
-      if (failed_targets_.count(Key(stage_pose))) continue;
-      const std::optional<double> t = c.travel_time_s(from, stage_pose);
-      if (!t) continue;
-      Cycle cycle;
-      cycle.object = &o;
-      cycle.knock = true;
-      cycle.pick_stage = stage_pose;
-      cycle.push_end = Eigen::Vector3d(end->x(), end->y(), heading);
-      cycle.score_stage = stage_pose;
-      cycle.goal = goal;
-      cycle.seconds = (*t + PushSeconds(c)) * Scale(kDrive) + frames / c.frame_rate_hz;
-      cycle.gain = points;  // on top of a structure it lies in no zone
-      // Straight off when the bumper meets it within half its width of its centre.
-      const double pose_var = PoseVarianceAfter(b, frames);
-      const Eigen::Matrix2d cov =
-          o.covariance + Eigen::Matrix2d::Identity() * (pose_var + b.pose_covariance(2, 2) * 0.25);
-      cycle.probability = SuccessProbability(cov, c.robot->width_m / 2.0) * o.confidence;
-      cycle.frames = frames;
-      out.push_back(cycle);
+      ways.push_back({Eigen::Vector3d(stage.x(), stage.y(), heading),
+                      Eigen::Vector3d(end->x(), end->y(), heading), goal, points});
     }
-    return out;
+    return knock_ways_.emplace(key, std::move(ways)).first->second;
   }
 
   // The run-in, and back out the same way (pressed against the structure the robot could not
@@ -600,6 +637,9 @@ class Base : public Strategy {
   std::map<long, int> failed_targets_;
   std::map<long, int> looked_;
   std::set<int> knocked_;
+  mutable std::map<std::pair<int, double>, std::vector<Eigen::Vector3d>> score_stages_;
+  mutable std::map<std::tuple<int, double, double, const field::Structure*>, std::vector<KnockWay>>
+      knock_ways_;
   bool surveyed_ = false;
   std::optional<Action> pending_;  // the last action chosen, and when
   double pending_start_s_ = 0.0;

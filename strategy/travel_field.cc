@@ -25,6 +25,10 @@ void TravelField::SetPlanner(const planning::Planner& planner) {
   width_ = grid.width / step;
   height_ = grid.height / step;
   origin_ = grid.origin_m;
+  // The distance fields stay valid while the coarse grid stays the same (the map often
+  // changes only where no coarse cell changes state): they are dropped only when it changes.
+  std::vector<std::uint8_t> before;
+  before.swap(blocked_);
   blocked_.assign(static_cast<size_t>(width_) * height_, 1);
   // A coarse cell is free when any of its fine cells is: narrow passages (a barrier's gap)
   // stay open; the times are estimates, and the executive plans on the fine grid.
@@ -42,7 +46,13 @@ void TravelField::SetPlanner(const planning::Planner& planner) {
       blocked_[static_cast<size_t>(r) * width_ + c] = all_blocked ? 1 : 0;
     }
   }
-  fields_.clear();
+  if (blocked_ != before || width_ != field_width_ || cell_m_ != field_cell_m_ ||
+      origin_ != field_origin_) {
+    fields_.clear();
+  }
+  field_width_ = width_;
+  field_cell_m_ = cell_m_;
+  field_origin_ = origin_;
 }
 
 std::optional<int> TravelField::CellOf(const Eigen::Vector2d& p) const {

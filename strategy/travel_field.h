@@ -22,7 +22,8 @@ class TravelField {
   // cell_m: edge of the coarse cells (a multiple of the planner's grid cell is best).
   TravelField(const field::DriveConfig& drive, double cell_m = 0.04);
 
-  // Takes the planner's current inflated grid; drops the cached fields.
+  // Takes the planner's current inflated grid; drops the cached fields when its coarse copy
+  // changed.
   void SetPlanner(const planning::Planner& planner);
 
   // Shortest collision-free distance between two points, or nothing when unreachable. A start
@@ -43,7 +44,10 @@ class TravelField {
   int width_ = 0, height_ = 0;
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
   std::vector<std::uint8_t> blocked_;
-  std::unordered_map<int, std::vector<float>> fields_;
+  std::unordered_map<int, std::vector<float>> fields_;  // by start cell, on blocked_
+  int field_width_ = 0;                                 // the grid fields_ were computed on
+  double field_cell_m_ = 0.0;
+  Eigen::Vector2d field_origin_ = Eigen::Vector2d::Zero();
 };
 
 }  // namespace slamo::strategy

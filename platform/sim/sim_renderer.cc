@@ -607,12 +607,6 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
     }
   }
   ray_length2_.resize(ray_length2_.size() + kPad, 1.0f);  // read four pixels at a time (kPad)
-  // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
-  // without a normal draw per pixel per frame. The pool holds four frames' worth of pixels
-  // (at least 2^20), so a frame's colour noise (3 per pixel) always fits after an offset.
-  std::normal_distribution<float> normal(0.0f, 1.0f);
-  normal_pool_.resize(std::max<size_t>(size_t{1} << 20, 4 * rays_cam_.size()));
-  for (float& x : normal_pool_) x = normal(rng_);
   BuildStaticPrimitives();
   // sigma(d) per millimetre of depth, so the per-pixel noise needs no table search.
   sigma_mm_by_mm_.resize(static_cast<size_t>(camera.max_range_m * 1000.0) + 2);
@@ -622,6 +616,15 @@ SimRenderer::SimRenderer(const field::SeasonConfig& season, const field::CameraC
 }
 
 SimRenderer::~SimRenderer() = default;
+
+void SimRenderer::FillNormalPool() {
+  // A pool of standard normal draws, read from a random offset each frame: per-pixel noise
+  // without a normal draw per pixel per frame. The pool holds four frames' worth of pixels
+  // (at least 2^20), so a frame's colour noise (3 per pixel) always fits after an offset.
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  normal_pool_.resize(std::max<size_t>(size_t{1} << 20, 4 * rays_cam_.size()));
+  for (float& x : normal_pool_) x = normal(rng_);
+}
 
 void SimRenderer::BuildStaticPrimitives() {
   for (const field::Structure& s : season_.structures) {
@@ -1226,6 +1229,9 @@ SLAMO_AVX_CLONES RgbdFrame SimRenderer::Render(const SimWorld& world, const Pose
   frame.colour.create(h, w, CV_8UC3);
   frame.depth_mm.create(h, w, CV_16UC1);
   // Noise comes from the pool, from a random offset each frame (contiguous: SIMD-friendly).
+  // The pool is drawn at the first frame (the first draws of rng_, as when the constructor
+  // drew it): a match that never looks (the scripted route) never pays for its million draws.
+  if (normal_pool_.empty()) FillNormalPool();
   const size_t n = static_cast<size_t>(w) * h;
   std::uniform_int_distribution<size_t> offset(0, normal_pool_.size() - 3 * n);
   const float* colour_noise = normal_pool_.data() + offset(rng_);

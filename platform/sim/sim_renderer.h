@@ -98,6 +98,7 @@ class SimRenderer {
   void RenderPass(const SimWorld& world, const Eigen::Isometry3d& world_from_camera,
                   const ArenaBackdrop* arena, Buffers* out) const;
   void BuildStaticPrimitives();
+  void FillNormalPool();
 
   const field::SeasonConfig& season_;
   field::CameraConfig camera_;
@@ -106,7 +107,8 @@ class SimRenderer {
   std::mt19937_64 rng_;
   std::vector<Eigen::Vector3f> rays_cam_;  // per pixel, z = 1
   std::vector<float> ray_length2_;         // per pixel, |ray|^2 (the same in every frame)
-  std::vector<float> normal_pool_;         // N(0, 1) draws, read from a random offset per frame
+  // N(0, 1) draws, read from a random offset per frame; drawn at the first frame.
+  std::vector<float> normal_pool_;
   std::vector<Primitive> static_primitives_;
   std::vector<Eigen::Vector3d> landmark_centres_;
   std::vector<float> sigma_mm_by_mm_;        // sigma(d) in mm, indexed by depth in whole mm
