@@ -108,6 +108,9 @@ struct Goal {
   double height_m = 0.0;         // opening height for a goal; 0 for a floor zone
   double yaw_deg = 0.0;
   std::map<std::string, int> points;  // object type -> points for one object scored here
+  // kEnds: a tube objects enter only through the two ends of its long axis (a box goal; the
+  // Push Back goals); kAny: from any side the robot reaches.
+  enum class Entry { kAny, kEnds } entry = Entry::kAny;
 };
 
 struct StartTile {

@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <tuple>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
@@ -161,9 +162,11 @@ class Base : public Strategy {
               "SCORE", kind, range, 0.0, std::sqrt(PoseVarianceAfter(b, frames))))
         return *p;
     }
-    // A goal structure forgives its radius less the drop's offset; a zone forgives more.
-    const double tolerance =
-        g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * g.radius_m) : 0.3;
+    // A goal structure forgives its half-width across the way in less the drop's offset (a
+    // box's radius_m is 0: its narrower half-size); a zone forgives more.
+    const double half =
+        g.shape == field::SolidShape::kCylinder ? g.radius_m : 0.5 * std::min(g.size_m.x, g.size_m.y);
+    const double tolerance = g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * half) : 0.3;
     const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() *
                                 (PoseVarianceAfter(b, frames) + b.pose_covariance(2, 2) * 0.25);
     return SuccessProbability(cov, tolerance);
@@ -1005,6 +1008,27 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
   const field::RobotConfig& robot = *context.robot;
   std::vector<Eigen::Vector3d> out;
   const Eigen::Vector2d centre(g.center_m.x, g.center_m.y);
+  if (g.kind == field::GoalKind::kGoal && g.entry == field::Goal::Entry::kEnds) {
+    // A tube: facing into one of its ends along the axis, the bumper just short of the mouth;
+    // the drop lands inside, past the mouth by the object's radius less the gap (the
+    // simulator takes it within one object size of the mouth, platform::GoalTakes).
+    const double reach = robot.length_m / 2.0 + 0.015;
+    const double inside = ReleaseDistance(robot, object_radius_m) - reach;
+    if (inside <= 0.0 || inside > 2.0 * object_radius_m) return out;
+    for (const platform::GoalMouth& m : platform::GoalMouths(g)) {
+      const double heading = std::atan2(m.inward.y(), m.inward.x());
+      const Eigen::Vector2d stage = m.point_m - (reach + margin_m) * m.inward;
+      const Eigen::Vector2d release = m.point_m - (reach + 0.01) * m.inward;
+      if (!context.is_clear(stage)) continue;
+      if (!platform::FootprintIsFree(*context.season,
+                                     platform::Pose2D{release.x(), release.y(), heading},
+                                     robot.length_m, robot.width_m, robot.height_m)) {
+        continue;
+      }
+      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+    }
+    return out;
+  }
   if (g.kind == field::GoalKind::kGoal) {
     // Bumper just short of the goal's edge; the drop then lands inside it.
     const double half = g.shape == field::SolidShape::kCylinder
@@ -1081,8 +1105,16 @@ Eigen::Vector2d DropTarget(const field::SeasonConfig& season, const field::Robot
                            int goal_index, const Eigen::Vector3d& stage, double object_radius_m,
                            double margin_m) {
   const field::Goal& g = season.goals[goal_index];
-  if (g.kind == field::GoalKind::kGoal) return Eigen::Vector2d(g.center_m.x, g.center_m.y);
   const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
+  if (g.kind == field::GoalKind::kGoal) {
+    // The mouth the stage faces (a goal without ends has one, at its centre).
+    const std::vector<platform::GoalMouth> mouths = platform::GoalMouths(g);
+    const auto best = std::max_element(
+        mouths.begin(), mouths.end(), [&](const platform::GoalMouth& a, const platform::GoalMouth& b) {
+          return a.inward.dot(dir) < b.inward.dot(dir);
+        });
+    return best->point_m;
+  }
   return stage.head<2>() + (ReleaseDistance(robot, object_radius_m) + margin_m) * dir;
 }
 

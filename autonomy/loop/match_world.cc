@@ -578,10 +578,11 @@ bool MatchWorld::Score(const strategy::Action& action) {
   const Eigen::Vector2d d = drop - est.head<2>();
   const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
   const field::Goal& goal = field_.goals[action.goal_index];
-  // Into a goal structure the bumper stops just short of its edge.
+  // Into a goal structure the bumper stops just short of its edge (a tube's: of its mouth).
   double forward = d.norm() - strategy::ReleaseDistance(robot_, r);
   if (goal.kind == field::GoalKind::kGoal) {
-    const double half = goal.shape == field::SolidShape::kCylinder
+    const double half = goal.entry == field::Goal::Entry::kEnds ? 0.0
+                        : goal.shape == field::SolidShape::kCylinder
                             ? goal.radius_m
                             : 0.5 * std::min(goal.size_m.x, goal.size_m.y);
     forward = d.norm() - (half + robot_.length_m / 2.0 + 0.015);

@@ -311,7 +311,9 @@ std::optional<ReleaseResult> SimField::Release() {
   result.object_id = o.id;
   for (size_t g = 0; g < season_.goals.size(); ++g) {
     const field::Goal& goal = season_.goals[g];
-    if (goal.kind == field::GoalKind::kGoal && GoalContains(goal, drop)) {
+    // Into a goal structure only the way objects go in (a tube: through an end).
+    if (goal.kind == field::GoalKind::kGoal &&
+        GoalTakes(goal, drop, pose.theta_rad, o.type->size_m)) {
       o.in_goal = static_cast<int>(g);
       o.center_m = Eigen::Vector3d(drop.x(), drop.y(), goal.height_m + o.type->height_m / 2.0);
       break;

@@ -169,6 +169,45 @@ TEST_F(SimFieldTest, ReleaseOverTheStashScoresTheGoal) {
   EXPECT_EQ(released->points, 5);
 }
 
+// Push Back's long goals are tubes blocks enter through their ends (entry: ends): a block
+// released from the tube's side stays in the intake; from the end, facing along the tube, it
+// goes in and scores 3.
+TEST(SimFieldPushBackTest, ABlockGoesIntoALongGoalThroughItsEndOnly) {
+  field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+  season.objects.clear();
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  const double r = 0.081 / 2.0;
+  const double bumper = robot.length_m / 2.0;
+  const auto block_ahead = [&](const Pose2D& pose) {
+    field::ObjectPlacement p;
+    p.type = "block";
+    p.colour = "red";
+    p.position_m = field::Vec2{pose.x_m + (bumper + r + 0.02) * std::cos(pose.theta_rad),
+                               pose.y_m + (bumper + r + 0.02) * std::sin(pose.theta_rad)};
+    field::SeasonConfig s = season;
+    s.objects.push_back(p);
+    return s;
+  };
+  // The long goal at y = -1.198 runs x = -0.62..0.62, 0.14 m wide. From the field side, the
+  // bumper 1.5 cm short of its side, the drop lands inside the tube's footprint.
+  const Pose2D side{0.0, -1.198 + 0.07 + 0.015 + bumper, -kPi / 2.0};
+  const field::SeasonConfig at_side = block_ahead(side);
+  SimField from_side(at_side, robot, Alliance::kRed, 1, side);
+  ASSERT_TRUE(from_side.Pick().has_value());
+  EXPECT_FALSE(from_side.Release().has_value()) << "no way in through the tube's side";
+  EXPECT_EQ(from_side.HeldCount(), 1);
+  // At the -x end, facing +x, the bumper 1.5 cm short of the mouth.
+  const Pose2D end{-0.62 - 0.015 - bumper, -1.198, 0.0};
+  const field::SeasonConfig at_end = block_ahead(end);
+  SimField from_end(at_end, robot, Alliance::kRed, 1, end);
+  ASSERT_TRUE(from_end.Pick().has_value());
+  const std::optional<ReleaseResult> released = from_end.Release();
+  ASSERT_TRUE(released.has_value());
+  ASSERT_TRUE(released->goal_index.has_value());
+  EXPECT_EQ(season.goals[*released->goal_index].name, "long_goal_right");
+  EXPECT_EQ(released->points, 3);
+}
+
 TEST_F(SimFieldTest, OpponentFollowsItsPathAndPushesObjects) {
   Place("buckyball", "blue", 0.0, 1.45);  // on the opponent's path
   field::OpponentRobot opponent;
