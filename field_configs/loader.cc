@@ -333,7 +333,8 @@ class SeasonParser {
 
   void ParseGoal(const YamlReader& node) {
     node.AllowKeys({"name", "kind", "alliance", "shape", "center_m", "size_m", "radius_m",
-                    "vertices_m", "height_m", "yaw_deg", "points", "entry"});
+                    "vertices_m", "height_m", "yaw_deg", "points", "entry",
+                    "on_object"});
     Goal g;
     g.name = node.Required("name").String();
     g.kind = node.Required("kind").OneOf({"zone", "goal"}) == 0 ? GoalKind::kZone : GoalKind::kGoal;
@@ -368,6 +369,15 @@ class SeasonParser {
       if (g.entry == Goal::Entry::kEnds &&
           (g.kind != GoalKind::kGoal || g.shape != SolidShape::kBox)) {
         entry->FailRule("entry: ends is for a box goal (kind: goal, shape: box)");
+      }
+    }
+    if (auto carrier = node.Optional("on_object")) {
+      g.on_object = carrier->String();
+      if (!config_->FindObjectType(g.on_object)) {
+        carrier->FailRule("unknown object type '" + g.on_object + "': expected " + KnownTypes());
+      }
+      if (g.kind != GoalKind::kGoal || g.shape != SolidShape::kCylinder) {
+        carrier->FailRule("on_object is for a cylinder goal (kind: goal, shape: cylinder)");
       }
     }
     const YamlReader points = node.Required("points");

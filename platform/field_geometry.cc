@@ -100,6 +100,12 @@ bool GoalTakes(const field::Goal& goal, const Eigen::Vector2d& drop, double head
   return false;
 }
 
+double CarrierRadius(const SeasonConfig& season, const field::Goal& goal) {
+  if (goal.on_object.empty()) return 0.0;
+  const field::ObjectType* type = season.FindObjectType(goal.on_object);
+  return type ? type->size_m / 2.0 : 0.0;
+}
+
 bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double length_m,
                      double width_m, double height_m) {
   const double c = std::cos(pose.theta_rad);

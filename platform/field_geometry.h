@@ -54,6 +54,9 @@ inline constexpr double kEntryAngle_deg = 30.0;
 bool GoalTakes(const field::Goal& goal, const Eigen::Vector2d& drop, double heading_rad,
                double object_size_m);
 
+// The radius of the object a goal stands on (Goal::on_object; 0 for a fixed goal).
+double CarrierRadius(const field::SeasonConfig& season, const field::Goal& goal);
+
 // Where a landmark is drawn: discs and squares as plates on the inner face of the nearest wall
 // (centre 5 mm off it), cylinders and spheres where the season puts them.
 Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& landmark);

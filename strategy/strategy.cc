@@ -65,10 +65,40 @@ class Base : public Strategy {
 
   Action Next(const Belief& b, const StrategyContext& c) final {
     LearnDuration(b);
-    Action a = Choose(b, c);
+    // Goals standing on movable objects (mobile goals) where those objects are seen.
+    field::SeasonConfig believed = *c.season;
+    MoveCarriedGoals(b, &believed);
+    StrategyContext here = c;
+    here.season = &believed;
+    Action a = Choose(b, here);
     pending_ = a;
     pending_start_s_ = b.now_s;
     return a;
+  }
+
+  // Each goal standing on an object (Goal::on_object) moves to the tracked object of that type
+  // nearest its spot in the file, within kCarrierMatch_m, each object taken once, nearest
+  // pairs first; unseen, it stays where the file puts it.
+  static void MoveCarriedGoals(const Belief& b, field::SeasonConfig* season) {
+    constexpr double kCarrierMatch_m = 0.9;
+    std::vector<std::tuple<double, size_t, size_t>> pairs;
+    for (size_t g = 0; g < season->goals.size(); ++g) {
+      const field::Goal& goal = season->goals[g];
+      if (goal.on_object.empty()) continue;
+      for (size_t k = 0; k < b.objects.size(); ++k) {
+        if (b.objects[k].kind != goal.on_object) continue;
+        const double d = (b.objects[k].position_m -
+                          Eigen::Vector2d(goal.center_m.x, goal.center_m.y)).norm();
+        if (d < kCarrierMatch_m) pairs.emplace_back(d, g, k);
+      }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    std::set<size_t> goals, objects;
+    for (const auto& [d, g, k] : pairs) {
+      if (goals.count(g) || objects.count(k)) continue;
+      goals.insert(g), objects.insert(k);
+      season->goals[g].center_m = field::Vec2{b.objects[k].position_m.x(), b.objects[k].position_m.y()};
+    }
   }
 
   void Feedback(const Action& action, bool succeeded) override {
@@ -176,10 +206,17 @@ class Base : public Strategy {
   // objects (other than `except`, and those smaller than min_size_m): an object pinned between
   // the bumper and a goal stops the robot short, so such approaches are not offered.
   static bool CorridorFree(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& stage,
-                           double length_m, int except, double min_size_m = 0.0) {
+                           double length_m, int except, double min_size_m = 0.0,
+                           const field::Goal* goal = nullptr) {
     const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
     for (const ObjectBelief& o : b.objects) {
       if (o.id == except) continue;
+      // The object the goal stands on is what the robot releases onto.
+      if (goal && !goal->on_object.empty() && o.kind == goal->on_object &&
+          (o.position_m - Eigen::Vector2d(goal->center_m.x, goal->center_m.y)).norm() <
+              platform::CarrierRadius(*c.season, *goal)) {
+        continue;
+      }
       const double r = ObjectRadius(*c.season, o.kind);
       if (2.0 * r < min_size_m) continue;
       const Eigen::Vector2d rel = o.position_m - stage.head<2>();
@@ -218,7 +255,10 @@ class Base : public Strategy {
           c.season->goals[g].kind == field::GoalKind::kZone ? c.robot->width_m : 0.0;
       for (const Eigen::Vector3d& stage : ScoreStages(c, g, r, options_.approach_margin_m)) {
         if (failed_targets_.count(Key(stage))) continue;
-        if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except, blocking)) continue;
+        if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except, blocking,
+                          &c.season->goals[g])) {
+          continue;
+        }
         const std::optional<double> t = c.travel_time_s(from, stage);
         if (!t) continue;
         const double seconds =
@@ -460,6 +500,8 @@ class Base : public Strategy {
     } else {
       a.kind = ActionKind::kScore;
       a.goal_index = cycle.goal;
+      a.goal_m = Eigen::Vector2d(c.season->goals[cycle.goal].center_m.x,
+                                 c.season->goals[cycle.goal].center_m.y);
       a.target = stage;
       a.expected_s = ApproachSeconds(c) + options_.release_s;
       a.why = "into " + c.season->goals[cycle.goal].name;
@@ -906,6 +948,8 @@ class ScriptedStrategy : public Base {
     Action score;
     score.kind = ActionKind::kScore;
     score.goal_index = cycle.goal;
+    score.goal_m = Eigen::Vector2d(c.season->goals[cycle.goal].center_m.x,
+                                   c.season->goals[cycle.goal].center_m.y);
     score.target = cycle.score_stage;
     score.expected_s = ApproachSeconds(c) + options_.release_s;
     score.why = "script: release";
@@ -1019,6 +1063,25 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
       const double heading = std::atan2(m.inward.y(), m.inward.x());
       const Eigen::Vector2d stage = m.point_m - (reach + margin_m) * m.inward;
       const Eigen::Vector2d release = m.point_m - (reach + 0.01) * m.inward;
+      if (!context.is_clear(stage)) continue;
+      if (!platform::FootprintIsFree(*context.season,
+                                     platform::Pose2D{release.x(), release.y(), heading},
+                                     robot.length_m, robot.width_m, robot.height_m)) {
+        continue;
+      }
+      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+    }
+    return out;
+  }
+  if (g.kind == field::GoalKind::kGoal && !g.on_object.empty()) {
+    // A stake on an object (a mobile goal): the bumper just short of the object's edge, the
+    // intake places the object onto the stake (the simulator's rule, SimField::Release).
+    const double reach = platform::CarrierRadius(*context.season, g) + robot.length_m / 2.0 + 0.015;
+    for (int k = 0; k < 12; ++k) {
+      const double heading = k * kPi / 6.0;
+      const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
+      const Eigen::Vector2d stage = centre - (reach + margin_m) * dir;
+      const Eigen::Vector2d release = centre - reach * dir;
       if (!context.is_clear(stage)) continue;
       if (!platform::FootprintIsFree(*context.season,
                                      platform::Pose2D{release.x(), release.y(), heading},

@@ -572,16 +572,20 @@ bool MatchWorld::Score(const strategy::Action& action) {
   const double r = ObjectRadius(held_->kind);
   const double margin = setup_.strategy_options.approach_margin_m;
   Observe(setup_.correction_frames);
+  const field::Goal& goal = field_.goals[action.goal_index];
+  // A goal on a movable object (a mobile goal's stake): where the strategy saw it.
   const Eigen::Vector2d drop =
-      strategy::DropTarget(field_, robot_, action.goal_index, action.target, r, margin);
+      goal.on_object.empty()
+          ? strategy::DropTarget(field_, robot_, action.goal_index, action.target, r, margin)
+          : action.goal_m;
   const Eigen::Vector3d est = slam_.pose();
   const Eigen::Vector2d d = drop - est.head<2>();
   const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
-  const field::Goal& goal = field_.goals[action.goal_index];
   // Into a goal structure the bumper stops just short of its edge (a tube's: of its mouth).
   double forward = d.norm() - strategy::ReleaseDistance(robot_, r);
   if (goal.kind == field::GoalKind::kGoal) {
     const double half = goal.entry == field::Goal::Entry::kEnds ? 0.0
+                        : !goal.on_object.empty() ? platform::CarrierRadius(field_, goal)
                         : goal.shape == field::SolidShape::kCylinder
                             ? goal.radius_m
                             : 0.5 * std::min(goal.size_m.x, goal.size_m.y);

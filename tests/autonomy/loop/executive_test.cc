@@ -395,6 +395,24 @@ TEST(Executive, TheV5RobotScoresInOverUnderAndPushBack) {
   }
 }
 
+// High Stakes with the V5 robot: the scripted route releases the preload and a picked ring
+// onto a mobile goal's stake (the stakes stand on their bases and move with them; before, the
+// robot pushed the base away from a stake that stayed put, and released onto the floor).
+TEST(Executive, TheV5RobotScoresRingsOnAHighStakesMobileGoal) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("high_stakes");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  MatchSetup setup;
+  setup.strategy = "scripted";
+  const MatchResult r = RunMatch(season, robot, setup, 1);
+  EXPECT_GE(r.points - r.points_start, 2) << "the preload and one ring (measured +2)";
+  EXPECT_EQ(r.overrun_s, 0.0);
+  for (const AttemptCheck& a : r.attempts) {
+    if (a.action == "SCORE" && a.outcome == "scored") {
+      EXPECT_EQ(season.goals[a.goal_index].on_object, "mobile_goal");
+    }
+  }
+}
+
 TEST(Executive, ActionThatWouldOverrunIsNotStarted) {
   field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
   season.rules.autonomous_s = 5.0;
