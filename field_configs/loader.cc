@@ -333,8 +333,7 @@ class SeasonParser {
 
   void ParseGoal(const YamlReader& node) {
     node.AllowKeys({"name", "kind", "alliance", "shape", "center_m", "size_m", "radius_m",
-                    "vertices_m", "height_m", "yaw_deg", "points", "entry",
-                    "on_object"});
+                    "vertices_m", "height_m", "yaw_deg", "points", "entry", "on_object"});
     Goal g;
     g.name = node.Required("name").String();
     g.kind = node.Required("kind").OneOf({"zone", "goal"}) == 0 ? GoalKind::kZone : GoalKind::kGoal;

@@ -5,8 +5,8 @@
 #include <limits>
 #include <map>
 #include <set>
-#include <tuple>
 #include <stdexcept>
+#include <tuple>
 
 #include <Eigen/Eigenvalues>
 
@@ -87,8 +87,8 @@ class Base : public Strategy {
       if (goal.on_object.empty()) continue;
       for (size_t k = 0; k < b.objects.size(); ++k) {
         if (b.objects[k].kind != goal.on_object) continue;
-        const double d = (b.objects[k].position_m -
-                          Eigen::Vector2d(goal.center_m.x, goal.center_m.y)).norm();
+        const double d =
+            (b.objects[k].position_m - Eigen::Vector2d(goal.center_m.x, goal.center_m.y)).norm();
         if (d < kCarrierMatch_m) pairs.emplace_back(d, g, k);
       }
     }
@@ -97,7 +97,8 @@ class Base : public Strategy {
     for (const auto& [d, g, k] : pairs) {
       if (goals.count(g) || objects.count(k)) continue;
       goals.insert(g), objects.insert(k);
-      season->goals[g].center_m = field::Vec2{b.objects[k].position_m.x(), b.objects[k].position_m.y()};
+      season->goals[g].center_m =
+          field::Vec2{b.objects[k].position_m.x(), b.objects[k].position_m.y()};
     }
   }
 
@@ -194,8 +195,9 @@ class Base : public Strategy {
     }
     // A goal structure forgives its half-width across the way in less the drop's offset (a
     // box's radius_m is 0: its narrower half-size); a zone forgives more.
-    const double half =
-        g.shape == field::SolidShape::kCylinder ? g.radius_m : 0.5 * std::min(g.size_m.x, g.size_m.y);
+    const double half = g.shape == field::SolidShape::kCylinder
+                            ? g.radius_m
+                            : 0.5 * std::min(g.size_m.x, g.size_m.y);
     const double tolerance = g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * half) : 0.3;
     const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() *
                                 (PoseVarianceAfter(b, frames) + b.pose_covariance(2, 2) * 0.25);
@@ -1172,10 +1174,11 @@ Eigen::Vector2d DropTarget(const field::SeasonConfig& season, const field::Robot
   if (g.kind == field::GoalKind::kGoal) {
     // The mouth the stage faces (a goal without ends has one, at its centre).
     const std::vector<platform::GoalMouth> mouths = platform::GoalMouths(g);
-    const auto best = std::max_element(
-        mouths.begin(), mouths.end(), [&](const platform::GoalMouth& a, const platform::GoalMouth& b) {
-          return a.inward.dot(dir) < b.inward.dot(dir);
-        });
+    const auto best =
+        std::max_element(mouths.begin(), mouths.end(),
+                         [&](const platform::GoalMouth& a, const platform::GoalMouth& b) {
+                           return a.inward.dot(dir) < b.inward.dot(dir);
+                         });
     return best->point_m;
   }
   return stage.head<2>() + (ReleaseDistance(robot, object_radius_m) + margin_m) * dir;

@@ -89,7 +89,8 @@ SimField::SimField(const field::SeasonConfig& season, const field::RobotConfig& 
     double best = std::numeric_limits<double>::infinity();
     for (const SimObject& o : world_.objects) {
       if (o.type->name != goal.on_object) continue;
-      const double d = std::hypot(o.center_m.x() - goal.center_m.x, o.center_m.y() - goal.center_m.y);
+      const double d =
+          std::hypot(o.center_m.x() - goal.center_m.x, o.center_m.y() - goal.center_m.y);
       if (d < best) best = d, nearest = &o;
     }
     if (nearest) carriers_.emplace_back(g, nearest->id);
@@ -340,11 +341,13 @@ std::optional<ReleaseResult> SimField::Release() {
     const field::Goal& goal = season_.goals[g];
     if (goal.on_object.empty()) continue;
     const Vector2d rel(goal.center_m.x - pose.x_m, goal.center_m.y - pose.y_m);
-    const double gap = c * rel.x() + s * rel.y() - CarrierRadius(season_, goal) - robot_.length_m / 2.0;
+    const double gap =
+        c * rel.x() + s * rel.y() - CarrierRadius(season_, goal) - robot_.length_m / 2.0;
     const double side = -s * rel.x() + c * rel.y();
     if (gap < -0.01 || gap > robot_.intake.reach_m || std::abs(side) > goal.radius_m) continue;
     o.in_goal = static_cast<int>(g);
-    o.center_m = Eigen::Vector3d(goal.center_m.x, goal.center_m.y, goal.height_m + o.type->height_m / 2.0);
+    o.center_m =
+        Eigen::Vector3d(goal.center_m.x, goal.center_m.y, goal.height_m + o.type->height_m / 2.0);
   }
   for (size_t g = 0; g < season_.goals.size() && o.in_goal < 0; ++g) {
     const field::Goal& goal = season_.goals[g];

@@ -389,7 +389,8 @@ TEST(Executive, TheV5RobotScoresInOverUnderAndPushBack) {
       EXPECT_GT(r.points, r.points_start) << name << " " << strategy;
       EXPECT_EQ(r.overrun_s, 0.0) << name << " " << strategy;
       int scored = 0;
-      for (const AttemptCheck& a : r.attempts) scored += a.action == "SCORE" && a.outcome == "scored";
+      for (const AttemptCheck& a : r.attempts)
+        scored += a.action == "SCORE" && a.outcome == "scored";
       EXPECT_GT(scored, 0) << name << " " << strategy << ": a release into a goal";
     }
   }
