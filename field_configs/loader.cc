@@ -333,7 +333,7 @@ class SeasonParser {
 
   void ParseGoal(const YamlReader& node) {
     node.AllowKeys({"name", "kind", "alliance", "shape", "center_m", "size_m", "radius_m",
-                    "vertices_m", "height_m", "yaw_deg", "points"});
+                    "vertices_m", "height_m", "yaw_deg", "points", "entry", "on_object"});
     Goal g;
     g.name = node.Required("name").String();
     g.kind = node.Required("kind").OneOf({"zone", "goal"}) == 0 ? GoalKind::kZone : GoalKind::kGoal;
@@ -363,6 +363,22 @@ class SeasonParser {
       g.height_m = h->NonNegative();
     }
     if (auto yaw = node.Optional("yaw_deg")) g.yaw_deg = yaw->InRange(-360.0, 360.0);
+    if (auto entry = node.Optional("entry")) {
+      g.entry = entry->OneOf({"any", "ends"}) == 0 ? Goal::Entry::kAny : Goal::Entry::kEnds;
+      if (g.entry == Goal::Entry::kEnds &&
+          (g.kind != GoalKind::kGoal || g.shape != SolidShape::kBox)) {
+        entry->FailRule("entry: ends is for a box goal (kind: goal, shape: box)");
+      }
+    }
+    if (auto carrier = node.Optional("on_object")) {
+      g.on_object = carrier->String();
+      if (!config_->FindObjectType(g.on_object)) {
+        carrier->FailRule("unknown object type '" + g.on_object + "': expected " + KnownTypes());
+      }
+      if (g.kind != GoalKind::kGoal || g.shape != SolidShape::kCylinder) {
+        carrier->FailRule("on_object is for a cylinder goal (kind: goal, shape: cylinder)");
+      }
+    }
     const YamlReader points = node.Required("points");
     for (const auto& [type_name, value] : points.Entries()) {
       if (!config_->FindObjectType(type_name)) {

@@ -108,6 +108,13 @@ struct Goal {
   double height_m = 0.0;         // opening height for a goal; 0 for a floor zone
   double yaw_deg = 0.0;
   std::map<std::string, int> points;  // object type -> points for one object scored here
+  // kEnds: a tube objects enter only through the two ends of its long axis (a box goal; the
+  // Push Back goals); kAny: from any side the robot reaches.
+  enum class Entry { kAny, kEnds } entry = Entry::kAny;
+  // Non-empty: the goal stands on an object of this type (a High Stakes mobile goal's stake on
+  // its base), placed at the goal's centre, and moves with it; a robot releases into it with
+  // its bumper just short of that object's edge (platform::CarrierRadius).
+  std::string on_object;
 };
 
 struct StartTile {

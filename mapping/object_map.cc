@@ -66,6 +66,21 @@ bool CylinderOverlaps(const Voxel& v, const Eigen::Vector2d& centre, double radi
   return r > 0 && SquaredDistance(v, Eigen::Vector3d(centre.x(), centre.y(), 0.0), 2) < r * r;
 }
 
+// Whether the voxel reaches into structure s (its footprint and its height range).
+bool StructureOverlaps(const Voxel& v, const field::Structure& s) {
+  if (!ZOverlaps(v, s.z_min_m, s.height_m)) return false;
+  const Eigen::Vector2d centre(s.center_m.x, s.center_m.y);
+  if (s.shape == field::SolidShape::kBox) {
+    return BoxOverlaps(v, centre, Eigen::Vector2d(s.size_m.x, s.size_m.y) / 2.0,
+                       s.yaw_deg * kDegToRad);
+  }
+  return CylinderOverlaps(v, centre, s.radius_m);
+}
+
+// A structure robots drive over, standing on the floor (a barrier pipe, a bump; not one they
+// pass under, which the grid's height band decides).
+bool DriveOver(const field::Structure& s) { return !s.blocks_robot && !s.PassUnder(); }
+
 bool SphereOverlaps(const Voxel& v, const Eigen::Vector3d& centre, double radius) {
   const double r = radius - kTouchEpsilon_m;
   return r > 0 && SquaredDistance(v, centre, 3) < r * r;
@@ -379,7 +394,17 @@ OccupancyGrid2D ObjectMap::ToGrid(double cell_m, double min_z_m, double max_z_m)
     const double h = it.getSize() / 2.0;
     const Voxel leaf{Eigen::Vector3d(it.getX(), it.getY(), it.getZ()), h};
     if (!ZOverlaps(leaf, min_z_m, max_z_m)) continue;
-    const bool occupied = tree_.isNodeOccupied(*it);
+    bool occupied = tree_.isNodeOccupied(*it);
+    // A structure robots drive over is no obstacle however tall (the Over Under barrier's
+    // 0.073 m pipe stands above the band's floor), unless a blocking one shares the voxel.
+    if (occupied && std::any_of(season_.structures.begin(), season_.structures.end(),
+                                [&](const field::Structure& s) {
+                                  return DriveOver(s) && StructureOverlaps(leaf, s);
+                                })) {
+      occupied = std::any_of(
+          season_.structures.begin(), season_.structures.end(),
+          [&](const field::Structure& s) { return !DriveOver(s) && StructureOverlaps(leaf, s); });
+    }
     const auto [col0, col1] =
         cell_range(leaf.centre.x() - h, leaf.centre.x() + h, grid.origin_m.x(), grid.width);
     const auto [row0, row1] =

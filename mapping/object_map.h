@@ -111,6 +111,7 @@ class ObjectMap {
 
   // Footprint of the voxels between min_z_m and max_z_m over the field and its walls: a cell
   // is occupied if any occupied voxel overlaps it, free if only free ones do, else unknown.
+  // Structures robots drive over (blocks_robot false, standing on the floor) are free.
   OccupancyGrid2D ToGrid(double cell_m, double min_z_m, double max_z_m) const;
 
   // .bt: maximum-likelihood occupancy only (octomap::OcTree reads it back).

@@ -75,6 +75,37 @@ bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p) {
   return std::abs(lx) <= goal.size_m.x / 2.0 && std::abs(ly) <= goal.size_m.y / 2.0;
 }
 
+std::vector<GoalMouth> GoalMouths(const field::Goal& goal) {
+  const Eigen::Vector2d centre(goal.center_m.x, goal.center_m.y);
+  if (goal.entry != field::Goal::Entry::kEnds) return {GoalMouth{centre, Eigen::Vector2d::Zero()}};
+  const double yaw = goal.yaw_deg * kPi / 180.0;
+  const bool along_x = goal.size_m.x >= goal.size_m.y;
+  const Eigen::Vector2d axis = along_x ? Eigen::Vector2d(std::cos(yaw), std::sin(yaw))
+                                       : Eigen::Vector2d(-std::sin(yaw), std::cos(yaw));
+  const double half = 0.5 * std::max(goal.size_m.x, goal.size_m.y);
+  return {GoalMouth{centre + half * axis, -axis}, GoalMouth{centre - half * axis, axis}};
+}
+
+bool GoalTakes(const field::Goal& goal, const Eigen::Vector2d& drop, double heading_rad,
+               double object_size_m) {
+  if (!GoalContains(goal, drop)) return false;
+  if (goal.entry != field::Goal::Entry::kEnds) return true;
+  const Eigen::Vector2d facing(std::cos(heading_rad), std::sin(heading_rad));
+  for (const GoalMouth& m : GoalMouths(goal)) {
+    if (facing.dot(m.inward) >= std::cos(kEntryAngle_deg * kPi / 180.0) &&
+        (drop - m.point_m).dot(m.inward) <= object_size_m) {
+      return true;
+    }
+  }
+  return false;
+}
+
+double CarrierRadius(const SeasonConfig& season, const field::Goal& goal) {
+  if (goal.on_object.empty()) return 0.0;
+  const field::ObjectType* type = season.FindObjectType(goal.on_object);
+  return type ? type->size_m / 2.0 : 0.0;
+}
+
 bool FootprintIsFree(const SeasonConfig& season, const Pose2D& pose, double length_m,
                      double width_m, double height_m) {
   // The structures that block this robot and could reach the footprint (the footprint lies

@@ -38,6 +38,25 @@ bool PointBlocksObject(const field::SeasonConfig& season, const Eigen::Vector2d&
 // True when the point lies inside a goal's footprint (box with yaw, cylinder or triangle).
 bool GoalContains(const field::Goal& goal, const Eigen::Vector2d& p);
 
+// The mouths of a goal structure: where an object goes in, and the direction into the goal
+// there. A goal with entry kEnds has one at the centre of each end face of its long axis; any
+// other goal one at its centre (direction zero: any side).
+struct GoalMouth {
+  Eigen::Vector2d point_m = Eigen::Vector2d::Zero();
+  Eigen::Vector2d inward = Eigen::Vector2d::Zero();
+};
+std::vector<GoalMouth> GoalMouths(const field::Goal& goal);
+
+// Whether an object released at `drop` by a robot heading `heading_rad` goes into the goal
+// structure: inside its footprint and, for an entry-kEnds tube, from a robot facing into one
+// of its ends (within kEntryAngle_deg of the axis) with the drop within one object size of it.
+inline constexpr double kEntryAngle_deg = 30.0;
+bool GoalTakes(const field::Goal& goal, const Eigen::Vector2d& drop, double heading_rad,
+               double object_size_m);
+
+// The radius of the object a goal stands on (Goal::on_object; 0 for a fixed goal).
+double CarrierRadius(const field::SeasonConfig& season, const field::Goal& goal);
+
 // Where a landmark is drawn: discs and squares as plates on the inner face of the nearest wall
 // (centre 5 mm off it), cylinders and spheres where the season puts them.
 Eigen::Vector3d LandmarkCentre(const field::SeasonConfig& season, const field::Landmark& landmark);

@@ -69,10 +69,41 @@ class Base : public Strategy {
     // The planner's map may have changed since the last decision.
     score_stages_.clear();
     knock_ways_.clear();
-    Action a = Choose(b, c);
+    // Goals standing on movable objects (mobile goals) where those objects are seen.
+    field::SeasonConfig believed = *c.season;
+    MoveCarriedGoals(b, &believed);
+    StrategyContext here = c;
+    here.season = &believed;
+    Action a = Choose(b, here);
     pending_ = a;
     pending_start_s_ = b.now_s;
     return a;
+  }
+
+  // Each goal standing on an object (Goal::on_object) moves to the tracked object of that type
+  // nearest its spot in the file, within kCarrierMatch_m, each object taken once, nearest
+  // pairs first; unseen, it stays where the file puts it.
+  static void MoveCarriedGoals(const Belief& b, field::SeasonConfig* season) {
+    constexpr double kCarrierMatch_m = 0.9;
+    std::vector<std::tuple<double, size_t, size_t>> pairs;
+    for (size_t g = 0; g < season->goals.size(); ++g) {
+      const field::Goal& goal = season->goals[g];
+      if (goal.on_object.empty()) continue;
+      for (size_t k = 0; k < b.objects.size(); ++k) {
+        if (b.objects[k].kind != goal.on_object) continue;
+        const double d =
+            (b.objects[k].position_m - Eigen::Vector2d(goal.center_m.x, goal.center_m.y)).norm();
+        if (d < kCarrierMatch_m) pairs.emplace_back(d, g, k);
+      }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    std::set<size_t> goals, objects;
+    for (const auto& [d, g, k] : pairs) {
+      if (goals.count(g) || objects.count(k)) continue;
+      goals.insert(g), objects.insert(k);
+      season->goals[g].center_m =
+          field::Vec2{b.objects[k].position_m.x(), b.objects[k].position_m.y()};
+    }
   }
 
   void Feedback(const Action& action, bool succeeded) override {
@@ -166,9 +197,12 @@ class Base : public Strategy {
               "SCORE", kind, range, 0.0, std::sqrt(PoseVarianceAfter(b, frames))))
         return *p;
     }
-    // A goal structure forgives its radius less the drop's offset; a zone forgives more.
-    const double tolerance =
-        g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * g.radius_m) : 0.3;
+    // A goal structure forgives its half-width across the way in less the drop's offset (a
+    // box's radius_m is 0: its narrower half-size); a zone forgives more.
+    const double half = g.shape == field::SolidShape::kCylinder
+                            ? g.radius_m
+                            : 0.5 * std::min(g.size_m.x, g.size_m.y);
+    const double tolerance = g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * half) : 0.3;
     const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() *
                                 (PoseVarianceAfter(b, frames) + b.pose_covariance(2, 2) * 0.25);
     return SuccessProbability(cov, tolerance);
@@ -178,10 +212,17 @@ class Base : public Strategy {
   // objects (other than `except`, and those smaller than min_size_m): an object pinned between
   // the bumper and a goal stops the robot short, so such approaches are not offered.
   static bool CorridorFree(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& stage,
-                           double length_m, int except, double min_size_m = 0.0) {
+                           double length_m, int except, double min_size_m = 0.0,
+                           const field::Goal* goal = nullptr) {
     const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
     for (const ObjectBelief& o : b.objects) {
       if (o.id == except) continue;
+      // The object the goal stands on is what the robot releases onto.
+      if (goal && !goal->on_object.empty() && o.kind == goal->on_object &&
+          (o.position_m - Eigen::Vector2d(goal->center_m.x, goal->center_m.y)).norm() <
+              platform::CarrierRadius(*c.season, *goal)) {
+        continue;
+      }
       const double r = ObjectRadius(*c.season, o.kind);
       if (2.0 * r < min_size_m) continue;
       const Eigen::Vector2d rel = o.position_m - stage.head<2>();
@@ -231,7 +272,10 @@ class Base : public Strategy {
           c.season->goals[g].kind == field::GoalKind::kZone ? c.robot->width_m : 0.0;
       for (const Eigen::Vector3d& stage : StagesFor(c, g, r)) {
         if (failed_targets_.count(Key(stage))) continue;
-        if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except, blocking)) continue;
+        if (!CorridorFree(b, c, stage, options_.approach_margin_m + r, except, blocking,
+                          &c.season->goals[g])) {
+          continue;
+        }
         const std::optional<double> t = c.travel_time_s(from, stage);
         if (!t) continue;
         const double seconds =
@@ -494,6 +538,8 @@ class Base : public Strategy {
     } else {
       a.kind = ActionKind::kScore;
       a.goal_index = cycle.goal;
+      a.goal_m = Eigen::Vector2d(c.season->goals[cycle.goal].center_m.x,
+                                 c.season->goals[cycle.goal].center_m.y);
       a.target = stage;
       a.expected_s = ApproachSeconds(c) + options_.release_s;
       a.why = "into " + c.season->goals[cycle.goal].name;
@@ -943,6 +989,8 @@ class ScriptedStrategy : public Base {
     Action score;
     score.kind = ActionKind::kScore;
     score.goal_index = cycle.goal;
+    score.goal_m = Eigen::Vector2d(c.season->goals[cycle.goal].center_m.x,
+                                   c.season->goals[cycle.goal].center_m.y);
     score.target = cycle.score_stage;
     score.expected_s = ApproachSeconds(c) + options_.release_s;
     score.why = "script: release";
@@ -1045,6 +1093,46 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
   const field::RobotConfig& robot = *context.robot;
   std::vector<Eigen::Vector3d> out;
   const Eigen::Vector2d centre(g.center_m.x, g.center_m.y);
+  if (g.kind == field::GoalKind::kGoal && g.entry == field::Goal::Entry::kEnds) {
+    // A tube: facing into one of its ends along the axis, the bumper just short of the mouth;
+    // the drop lands inside, past the mouth by the object's radius less the gap (the
+    // simulator takes it within one object size of the mouth, platform::GoalTakes).
+    const double reach = robot.length_m / 2.0 + 0.015;
+    const double inside = ReleaseDistance(robot, object_radius_m) - reach;
+    if (inside <= 0.0 || inside > 2.0 * object_radius_m) return out;
+    for (const platform::GoalMouth& m : platform::GoalMouths(g)) {
+      const double heading = std::atan2(m.inward.y(), m.inward.x());
+      const Eigen::Vector2d stage = m.point_m - (reach + margin_m) * m.inward;
+      const Eigen::Vector2d release = m.point_m - (reach + 0.01) * m.inward;
+      if (!context.is_clear(stage)) continue;
+      if (!platform::FootprintIsFree(*context.season,
+                                     platform::Pose2D{release.x(), release.y(), heading},
+                                     robot.length_m, robot.width_m, robot.height_m)) {
+        continue;
+      }
+      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+    }
+    return out;
+  }
+  if (g.kind == field::GoalKind::kGoal && !g.on_object.empty()) {
+    // A stake on an object (a mobile goal): the bumper just short of the object's edge, the
+    // intake places the object onto the stake (the simulator's rule, SimField::Release).
+    const double reach = platform::CarrierRadius(*context.season, g) + robot.length_m / 2.0 + 0.015;
+    for (int k = 0; k < 12; ++k) {
+      const double heading = k * kPi / 6.0;
+      const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
+      const Eigen::Vector2d stage = centre - (reach + margin_m) * dir;
+      const Eigen::Vector2d release = centre - reach * dir;
+      if (!context.is_clear(stage)) continue;
+      if (!platform::FootprintIsFree(*context.season,
+                                     platform::Pose2D{release.x(), release.y(), heading},
+                                     robot.length_m, robot.width_m, robot.height_m)) {
+        continue;
+      }
+      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+    }
+    return out;
+  }
   if (g.kind == field::GoalKind::kGoal) {
     // Bumper just short of the goal's edge; the drop then lands inside it.
     const double half = g.shape == field::SolidShape::kCylinder
@@ -1121,8 +1209,17 @@ Eigen::Vector2d DropTarget(const field::SeasonConfig& season, const field::Robot
                            int goal_index, const Eigen::Vector3d& stage, double object_radius_m,
                            double margin_m) {
   const field::Goal& g = season.goals[goal_index];
-  if (g.kind == field::GoalKind::kGoal) return Eigen::Vector2d(g.center_m.x, g.center_m.y);
   const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
+  if (g.kind == field::GoalKind::kGoal) {
+    // The mouth the stage faces (a goal without ends has one, at its centre).
+    const std::vector<platform::GoalMouth> mouths = platform::GoalMouths(g);
+    const auto best =
+        std::max_element(mouths.begin(), mouths.end(),
+                         [&](const platform::GoalMouth& a, const platform::GoalMouth& b) {
+                           return a.inward.dot(dir) < b.inward.dot(dir);
+                         });
+    return best->point_m;
+  }
   return stage.head<2>() + (ReleaseDistance(robot, object_radius_m) + margin_m) * dir;
 }
 

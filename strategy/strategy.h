@@ -92,6 +92,9 @@ struct Action {
   double expected_s = 0.0;       // the strategy's estimate of the action's duration
   double expected_points = 0.0;  // expected points of the sequence this action starts
   std::string why;               // one line for the timeline
+  // kScore: where the strategy believes the goal stands (a goal on a movable object, such as
+  // a mobile goal's stake, where it was seen; else the season file's centre).
+  Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();
 };
 
 // Durations and tolerances the strategy plans with (measured on the simulator or the robot).

@@ -168,6 +168,18 @@ field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitte
     }
     if (p.stack_size > 1) stack_bottom = p.position_m;
   }
+  // A goal standing on an object (a mobile goal's stake) goes where that object went.
+  for (field::Goal& g : out.goals) {
+    if (g.on_object.empty()) continue;
+    for (size_t i = 0; i < season.objects.size(); ++i) {
+      const field::ObjectPlacement& p = season.objects[i];
+      if (p.type != g.on_object || !p.position_m) continue;
+      if (std::hypot(p.position_m->x - g.center_m.x, p.position_m->y - g.center_m.y) > 0.01)
+        continue;
+      g.center_m = *out.objects[i].position_m;
+      break;
+    }
+  }
   return out;
 }
 

@@ -31,7 +31,8 @@ DriveStep Forward(double metres) {
 
 // Frames taken to check an arrival, and how close counts as arrived.
 // Cut the motors this long before the target at the current speed: the slow creep of the last
-// centimetres (PWM deadband) costs more time than the coast-in error SLAM-O corrects.
+// centimetres (PWM deadband) costs more time than the coast-in error SLAM-O corrects (the
+// thesis robot's, which has no motor model in its file).
 constexpr double kStopLead_s = 0.15;
 constexpr double kMinSpeed_mps = 0.06;
 
@@ -166,7 +167,12 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
   // Do not wait for the last encoder tick of a coasting wheel: the odometry keeps counting
   // it into the next step.
   drive_options_.max_settle_s = 0.4;
-  drive_options_.stop_lead_s = kStopLead_s;
+  // A robot file with its own motor model: cut one motor time constant early, which is how far
+  // (x speed) the wheels coast once cut. The V5 robot's 3 m/s^2 ramps reach the last 0.135 m at
+  // full speed, so the thesis robot's 0.15 s lead stopped every approach ~9 cm short, and its
+  // releases landed outside the Over Under and Push Back goals.
+  drive_options_.stop_lead_s =
+      robot_.drive.slip ? robot_.drive.slip->motor_time_constant_s : kStopLead_s;
   drive_options_.min_speed_mps = kMinSpeed_mps;
 
   planning::PlannerOptions planner_options;
@@ -566,16 +572,21 @@ bool MatchWorld::Score(const strategy::Action& action) {
   const double r = ObjectRadius(held_->kind);
   const double margin = setup_.strategy_options.approach_margin_m;
   Observe(setup_.correction_frames);
+  const field::Goal& goal = field_.goals[action.goal_index];
+  // A goal on a movable object (a mobile goal's stake): where the strategy saw it.
   const Eigen::Vector2d drop =
-      strategy::DropTarget(field_, robot_, action.goal_index, action.target, r, margin);
+      goal.on_object.empty()
+          ? strategy::DropTarget(field_, robot_, action.goal_index, action.target, r, margin)
+          : action.goal_m;
   const Eigen::Vector3d est = slam_.pose();
   const Eigen::Vector2d d = drop - est.head<2>();
   const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
-  const field::Goal& goal = field_.goals[action.goal_index];
-  // Into a goal structure the bumper stops just short of its edge.
+  // Into a goal structure the bumper stops just short of its edge (a tube's: of its mouth).
   double forward = d.norm() - strategy::ReleaseDistance(robot_, r);
   if (goal.kind == field::GoalKind::kGoal) {
-    const double half = goal.shape == field::SolidShape::kCylinder
+    const double half = goal.entry == field::Goal::Entry::kEnds ? 0.0
+                        : !goal.on_object.empty() ? platform::CarrierRadius(field_, goal)
+                        : goal.shape == field::SolidShape::kCylinder
                             ? goal.radius_m
                             : 0.5 * std::min(goal.size_m.x, goal.size_m.y);
     forward = d.norm() - (half + robot_.length_m / 2.0 + 0.015);

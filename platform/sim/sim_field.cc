@@ -82,6 +82,20 @@ SimField::SimField(const field::SeasonConfig& season, const field::RobotConfig& 
       world_(CreateWorld(season_, seed)),
       drive_(robot.drive, drive_options, seed, start) {
   world_.season = &season_;
+  for (size_t g = 0; g < season_.goals.size(); ++g) {
+    const field::Goal& goal = season_.goals[g];
+    if (goal.on_object.empty()) continue;
+    const SimObject* nearest = nullptr;
+    double best = std::numeric_limits<double>::infinity();
+    for (const SimObject& o : world_.objects) {
+      if (o.type->name != goal.on_object) continue;
+      const double d =
+          std::hypot(o.center_m.x() - goal.center_m.x, o.center_m.y() - goal.center_m.y);
+      if (d < best) best = d, nearest = &o;
+    }
+    if (nearest) carriers_.emplace_back(g, nearest->id);
+  }
+  FollowCarriers();
   drive_.SetFreeSpaceCheck([this](const Pose2D& pose) { return RobotPoseIsFree(pose); });
   if (options_.preload) Preload();
   // An object under the robot at the start is pushed clear of it.
@@ -93,7 +107,17 @@ void SimField::Step(double dt_s) {
   PushOut(drive_.true_pose(), robot_.length_m, robot_.width_m, robot_.height_m);
   for (size_t i = 0; i < world_.opponents.size(); ++i) StepOpponent(i, dt_s);
   Settle();
+  FollowCarriers();
   time_s_ += dt_s;
+}
+
+void SimField::FollowCarriers() {
+  for (const auto& [g, id] : carriers_) {
+    for (const SimObject& o : world_.objects) {
+      if (o.id != id) continue;
+      season_.goals[g].center_m = field::Vec2{o.center_m.x(), o.center_m.y()};
+    }
+  }
 }
 
 void SimField::Settle() {
@@ -309,9 +333,27 @@ std::optional<ReleaseResult> SimField::Release() {
                       pose.y_m + ahead * std::sin(pose.theta_rad));
   ReleaseResult result;
   result.object_id = o.id;
-  for (size_t g = 0; g < season_.goals.size(); ++g) {
+  // Onto a stake standing on an object (a mobile goal) the intake places it: the stake's base
+  // within the intake's reach ahead of the bumper (as a pick's near edge), the stake within
+  // the goal's radius of the robot's centre line.
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  for (size_t g = 0; g < season_.goals.size() && o.in_goal < 0; ++g) {
     const field::Goal& goal = season_.goals[g];
-    if (goal.kind == field::GoalKind::kGoal && GoalContains(goal, drop)) {
+    if (goal.on_object.empty()) continue;
+    const Vector2d rel(goal.center_m.x - pose.x_m, goal.center_m.y - pose.y_m);
+    const double gap =
+        c * rel.x() + s * rel.y() - CarrierRadius(season_, goal) - robot_.length_m / 2.0;
+    const double side = -s * rel.x() + c * rel.y();
+    if (gap < -0.01 || gap > robot_.intake.reach_m || std::abs(side) > goal.radius_m) continue;
+    o.in_goal = static_cast<int>(g);
+    o.center_m =
+        Eigen::Vector3d(goal.center_m.x, goal.center_m.y, goal.height_m + o.type->height_m / 2.0);
+  }
+  for (size_t g = 0; g < season_.goals.size() && o.in_goal < 0; ++g) {
+    const field::Goal& goal = season_.goals[g];
+    // Into a goal structure only the way objects go in (a tube: through an end).
+    if (goal.kind == field::GoalKind::kGoal && goal.on_object.empty() &&
+        GoalTakes(goal, drop, pose.theta_rad, o.type->size_m)) {
       o.in_goal = static_cast<int>(g);
       o.center_m = Eigen::Vector3d(drop.x(), drop.y(), goal.height_m + o.type->height_m / 2.0);
       break;

@@ -83,6 +83,10 @@ class SimField {
   void StepOpponent(size_t index, double dt_s);
   void Preload();
 
+  // Goals standing on an object (Goal::on_object) follow it: goal index -> object id.
+  void FollowCarriers();
+  std::vector<std::pair<size_t, int>> carriers_;
+
   field::SeasonConfig season_;
   field::RobotConfig robot_;
   field::Alliance alliance_;

@@ -181,6 +181,24 @@ TEST_F(ObjectMapTest, GridMarksTheRedGoalOccupiedAndTheStartTilesFree) {
   EXPECT_EQ(high.cells[*high.IndexOf({0.0, -1.0})], OccupancyGrid2D::kUnknown);
 }
 
+// Over Under's barrier is a 0.073 m pipe robots climb over (blocks_robot: false): taller than
+// the grid's 0.06 m floor, it used to close the field's two halves to the planner, and the V5
+// robot found no way to any goal or zone of its (seed 1 idled from 3 s). Its elevation posts
+// still block.
+TEST(ObjectMapOverUnderTest, TheGridLeavesStructuresRobotsDriveOverFree) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("over_under");
+  const ObjectMap map(season);
+  const OccupancyGrid2D grid = map.ToGrid(0.05, 0.06, 0.45);
+  const auto at = [&grid](double x, double y) { return grid.cells[*grid.IndexOf({x, y})]; };
+  EXPECT_EQ(at(0.0, 0.6), OccupancyGrid2D::kFree) << "the long barrier";
+  EXPECT_EQ(at(0.4, 1.197), OccupancyGrid2D::kFree) << "a short barrier";
+  EXPECT_EQ(at(0.0, -1.197), OccupancyGrid2D::kOccupied) << "the red elevation post";
+  EXPECT_EQ(at(0.0, -1.5), OccupancyGrid2D::kOccupied) << "its bar, lower than the robot";
+  EXPECT_EQ(at(1.5, 0.0), OccupancyGrid2D::kOccupied) << "the red goal's frame";
+  // The octree still holds the barrier (pictures, the 3D map).
+  EXPECT_TRUE(map.IsOccupied(Eigen::Vector3d(0.0, 0.6, 0.05)));
+}
+
 TEST_F(ObjectMapTest, PointCloudClearsAlongRaysAndMarksHits) {
   // A board ~1 m ahead of a sensor 20 cm up, where the season has nothing.
   std::vector<Eigen::Vector3d> points;

@@ -374,6 +374,46 @@ TEST(Executive, AnObjectThatScoresNothingIsDroppedToFreeTheIntake) {
   }
 }
 
+// The 15 s seasons with the V5 robot (#15): on seed 1 every strategy gained nothing. Over
+// Under: the planner's grid took the 0.073 m barrier robots climb over for a wall, so no goal
+// or zone of red's was reachable and the planner idled from 3 s. Push Back: releases went at
+// the long goal's side, which blocks go in only through its ends.
+TEST(Executive, TheV5RobotScoresInOverUnderAndPushBack) {
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  for (const std::string name : {"over_under", "push_back"}) {
+    const field::SeasonConfig season = field::LoadSeasonConfig(name);
+    for (const std::string strategy : {"planner", "scripted"}) {
+      MatchSetup setup;
+      setup.strategy = strategy;
+      const MatchResult r = RunMatch(season, robot, setup, 1);
+      EXPECT_GT(r.points, r.points_start) << name << " " << strategy;
+      EXPECT_EQ(r.overrun_s, 0.0) << name << " " << strategy;
+      int scored = 0;
+      for (const AttemptCheck& a : r.attempts)
+        scored += a.action == "SCORE" && a.outcome == "scored";
+      EXPECT_GT(scored, 0) << name << " " << strategy << ": a release into a goal";
+    }
+  }
+}
+
+// High Stakes with the V5 robot: the scripted route releases the preload and a picked ring
+// onto a mobile goal's stake (the stakes stand on their bases and move with them; before, the
+// robot pushed the base away from a stake that stayed put, and released onto the floor).
+TEST(Executive, TheV5RobotScoresRingsOnAHighStakesMobileGoal) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("high_stakes");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  MatchSetup setup;
+  setup.strategy = "scripted";
+  const MatchResult r = RunMatch(season, robot, setup, 1);
+  EXPECT_GE(r.points - r.points_start, 2) << "the preload and one ring (measured +2)";
+  EXPECT_EQ(r.overrun_s, 0.0);
+  for (const AttemptCheck& a : r.attempts) {
+    if (a.action == "SCORE" && a.outcome == "scored") {
+      EXPECT_EQ(season.goals[a.goal_index].on_object, "mobile_goal");
+    }
+  }
+}
+
 TEST(Executive, ActionThatWouldOverrunIsNotStarted) {
   field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
   season.rules.autonomous_s = 5.0;

@@ -169,6 +169,89 @@ TEST_F(SimFieldTest, ReleaseOverTheStashScoresTheGoal) {
   EXPECT_EQ(released->points, 5);
 }
 
+// Push Back's long goals are tubes blocks enter through their ends (entry: ends): a block
+// released from the tube's side stays in the intake; from the end, facing along the tube, it
+// goes in and scores 3.
+TEST(SimFieldPushBackTest, ABlockGoesIntoALongGoalThroughItsEndOnly) {
+  field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+  season.objects.clear();
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  const double r = 0.081 / 2.0;
+  const double bumper = robot.length_m / 2.0;
+  const auto block_ahead = [&](const Pose2D& pose) {
+    field::ObjectPlacement p;
+    p.type = "block";
+    p.colour = "red";
+    p.position_m = field::Vec2{pose.x_m + (bumper + r + 0.02) * std::cos(pose.theta_rad),
+                               pose.y_m + (bumper + r + 0.02) * std::sin(pose.theta_rad)};
+    field::SeasonConfig s = season;
+    s.objects.push_back(p);
+    return s;
+  };
+  // The long goal at y = -1.198 runs x = -0.62..0.62, 0.14 m wide. From the field side, the
+  // bumper 1.5 cm short of its side, the drop lands inside the tube's footprint.
+  const Pose2D side{0.0, -1.198 + 0.07 + 0.015 + bumper, -kPi / 2.0};
+  const field::SeasonConfig at_side = block_ahead(side);
+  SimField from_side(at_side, robot, Alliance::kRed, 1, side);
+  ASSERT_TRUE(from_side.Pick().has_value());
+  EXPECT_FALSE(from_side.Release().has_value()) << "no way in through the tube's side";
+  EXPECT_EQ(from_side.HeldCount(), 1);
+  // At the -x end, facing +x, the bumper 1.5 cm short of the mouth.
+  const Pose2D end{-0.62 - 0.015 - bumper, -1.198, 0.0};
+  const field::SeasonConfig at_end = block_ahead(end);
+  SimField from_end(at_end, robot, Alliance::kRed, 1, end);
+  ASSERT_TRUE(from_end.Pick().has_value());
+  const std::optional<ReleaseResult> released = from_end.Release();
+  ASSERT_TRUE(released.has_value());
+  ASSERT_TRUE(released->goal_index.has_value());
+  EXPECT_EQ(season.goals[*released->goal_index].name, "long_goal_right");
+  EXPECT_EQ(released->points, 3);
+}
+
+// High Stakes: a mobile goal's stake stands on its base and moves with it (on_object). A ring
+// released with the bumper at the base, the stake within the intake's reach, goes onto the
+// stake and scores 1, wherever the goal has been pushed to; before, the stakes stayed at the
+// file's spots while the robot pushed the bases away, and releases went onto the floor.
+TEST(SimFieldHighStakesTest, ARingGoesOntoTheStakeOfTheMobileGoalItWasPushedWith) {
+  field::SeasonConfig season = field::LoadSeasonConfig("high_stakes");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  // Mobile goal 1 only, moved 0.3 m from its spot (-0.599, 0.599) as after a push, and a red
+  // ring to take.
+  season.objects.clear();
+  field::ObjectPlacement goal;
+  goal.type = "mobile_goal";
+  goal.colour = "yellow";
+  goal.position_m = field::Vec2{-0.899, 0.599};
+  season.objects.push_back(goal);
+  const double base_r = 0.264 / 2.0, bumper = robot.length_m / 2.0;
+  const Pose2D pose{-0.899 - base_r - 0.015 - bumper, 0.599, 0.0};
+  field::ObjectPlacement ring;  // the preload, under the robot
+  ring.type = "ring";
+  ring.colour = "red";
+  ring.position_m = field::Vec2{pose.x_m, pose.y_m};
+  season.objects.push_back(ring);
+  // The goal follows its base: its stake is where the base was placed, not at the file's spot.
+  int goal_index = -1;
+  for (size_t g = 0; g < season.goals.size(); ++g)
+    if (season.goals[g].name == "mobile_goal_1") goal_index = static_cast<int>(g);
+  ASSERT_GE(goal_index, 0);
+  SimFieldOptions options;
+  options.preload = true;
+  SimField field(season, robot, Alliance::kRed, 1, pose, {}, options);
+  ASSERT_EQ(field.HeldCount(), 1);
+  const std::optional<ReleaseResult> released = field.Release();
+  ASSERT_TRUE(released.has_value());
+  ASSERT_TRUE(released->goal_index.has_value());
+  EXPECT_EQ(*released->goal_index, goal_index);
+  EXPECT_EQ(released->points, 1);
+  // Pushed on by the robot, the base carries the stake and the ring on it.
+  SimClock clock;
+  RunDriveScript(ParseDriveScript("forward 0.15"), DriveControllerOptionsFor(robot.drive),
+                 &field.drive(), &clock, [&field](double dt) { field.Step(dt); });
+  EXPECT_GT(field.world().objects[0].center_m.x(), -0.899 + 0.05);
+  EXPECT_EQ(field.Score(Alliance::kRed), 1);
+}
+
 TEST_F(SimFieldTest, OpponentFollowsItsPathAndPushesObjects) {
   Place("buckyball", "blue", 0.0, 1.45);  // on the opponent's path
   field::OpponentRobot opponent;
