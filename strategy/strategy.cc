@@ -1093,6 +1093,17 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
   const field::RobotConfig& robot = *context.robot;
   std::vector<Eigen::Vector3d> out;
   const Eigen::Vector2d centre(g.center_m.x, g.center_m.y);
+  // A goal's staging pose is kept when its spot is clear in the map and the robot at the
+  // release, facing `heading`, overlaps nothing fixed in `season`.
+  const auto keep = [&](const Eigen::Vector2d& stage, const Eigen::Vector2d& release,
+                        double heading, const field::SeasonConfig& season) {
+    if (!context.is_clear(stage)) return;
+    if (!platform::FootprintIsFree(season, platform::Pose2D{release.x(), release.y(), heading},
+                                   robot.length_m, robot.width_m, robot.height_m)) {
+      return;
+    }
+    out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+  };
   if (g.kind == field::GoalKind::kGoal && g.entry == field::Goal::Entry::kEnds) {
     // A tube: facing into one of its ends along the axis, the bumper just short of the mouth;
     // the drop lands inside, past the mouth by the object's radius less the gap (the
@@ -1104,13 +1115,7 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
       const double heading = std::atan2(m.inward.y(), m.inward.x());
       const Eigen::Vector2d stage = m.point_m - (reach + margin_m) * m.inward;
       const Eigen::Vector2d release = m.point_m - (reach + 0.01) * m.inward;
-      if (!context.is_clear(stage)) continue;
-      if (!platform::FootprintIsFree(*context.season,
-                                     platform::Pose2D{release.x(), release.y(), heading},
-                                     robot.length_m, robot.width_m, robot.height_m)) {
-        continue;
-      }
-      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+      keep(stage, release, heading, *context.season);
     }
     return out;
   }
@@ -1122,14 +1127,7 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
       const double heading = k * kPi / 6.0;
       const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
       const Eigen::Vector2d stage = centre - (reach + margin_m) * dir;
-      const Eigen::Vector2d release = centre - reach * dir;
-      if (!context.is_clear(stage)) continue;
-      if (!platform::FootprintIsFree(*context.season,
-                                     platform::Pose2D{release.x(), release.y(), heading},
-                                     robot.length_m, robot.width_m, robot.height_m)) {
-        continue;
-      }
-      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+      keep(stage, centre - reach * dir, heading, *context.season);
     }
     return out;
   }
@@ -1153,13 +1151,7 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
       const double heading = k * kPi / 6.0;
       const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
       const Eigen::Vector2d stage = centre - (reach + margin_m) * dir;
-      const Eigen::Vector2d release = centre - (reach + 0.01) * dir;
-      if (!context.is_clear(stage)) continue;
-      if (!platform::FootprintIsFree(others, platform::Pose2D{release.x(), release.y(), heading},
-                                     robot.length_m, robot.width_m, robot.height_m)) {
-        continue;
-      }
-      out.emplace_back(stage.x(), stage.y(), Wrap(heading));
+      keep(stage, centre - (reach + 0.01) * dir, heading, others);
     }
     return out;
   }
