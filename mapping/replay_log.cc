@@ -176,7 +176,7 @@ class RawlogReader {
   ReplayLog Read() {
     if (!std::ifstream(path_)) throw ReplayLogError(path_ + ": cannot open");
     try {
-      records_ = std::make_unique<platform::RawlogRecords>(path_);
+      records_ = std::make_unique<platform::RawlogRecords>(path_, options_.rawlog_check_timeout_s);
       while (const std::optional<platform::RawlogEntry> entry = records_->Next()) {
         if (entry->actions) {
           AddActions(*entry->actions);

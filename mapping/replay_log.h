@@ -68,6 +68,9 @@ struct ReplayLog {
 struct ReplayLogOptions {
   double sigma_range_m = 0.05;      // for obs lines without sigmas
   double sigma_bearing_rad = 0.03;  // for obs lines without sigmas
+  // A rawlog is first read whole in a child process (platform/rawlog_guard.h); one that takes
+  // longer than this is reported as hanging MRPT's deserialiser (a ReplayLogError).
+  double rawlog_check_timeout_s = 120.0;
 };
 
 // The text format above.

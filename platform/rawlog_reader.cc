@@ -63,10 +63,11 @@ struct RawlogRecords::Impl {
   }
 };
 
-RawlogRecords::RawlogRecords(const std::string& path) : impl_(std::make_unique<Impl>()) {
+RawlogRecords::RawlogRecords(const std::string& path, double check_timeout_s)
+    : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   // A record that crashes or hangs MRPT's deserialiser does so in a child process.
-  if (const std::optional<std::string> crash = CheckRawlogInChildProcess(path))
+  if (const std::optional<std::string> crash = CheckRawlogInChildProcess(path, check_timeout_s))
     throw RawlogError(path + ": " + *crash + ": not a rawlog slamo can read");
   bool ok = false;
   try {

@@ -41,7 +41,9 @@ class RawlogRecords {
   // RawlogError: "<path>: <what the child met>: not a rawlog slamo can read",
   // "<path>: cannot open" or "<path>: cannot open (<MRPT's message>)". Whether the file
   // exists is the caller's to check first (the readers word that error differently).
-  explicit RawlogRecords(const std::string& path);
+  // `check_timeout_s` bounds the child's read: longer, and the file is taken as one that hangs
+  // MRPT's deserialiser (a 36 MB rawlog reads in about a second).
+  explicit RawlogRecords(const std::string& path, double check_timeout_s = 120.0);
   ~RawlogRecords();
   RawlogRecords(const RawlogRecords&) = delete;
   RawlogRecords& operator=(const RawlogRecords&) = delete;
