@@ -21,6 +21,54 @@ std::optional<std::pair<Eigen::Vector3d, double>> RayOnPlane(const CameraModel& 
   return std::make_pair(Eigen::Vector3d(origin + s * direction), s);
 }
 
+// The structures of FieldBounds::solids (see there for what is left out).
+void AddSolids(const field::SeasonConfig& season, FieldBounds* bounds) {
+  for (const field::Structure& st : season.structures) {
+    if (st.colour.empty() || st.shape == field::SolidShape::kTriangle) continue;
+    FieldBounds::Solid solid;
+    solid.colour = st.colour;
+    solid.cylinder = st.shape == field::SolidShape::kCylinder;
+    solid.centre_m = {st.center_m.x, st.center_m.y};
+    solid.half_size_m = {st.size_m.x / 2.0, st.size_m.y / 2.0};
+    solid.radius_m = st.radius_m;
+    solid.yaw_rad = st.yaw_deg * 3.14159265358979323846 / 180.0;
+    solid.z_min_m = st.z_min_m;
+    solid.z_max_m = st.height_m;
+    bool hollow = false;
+    for (const field::Goal& g : season.goals) {
+      if (g.kind != field::GoalKind::kGoal) continue;
+      const double reach = g.radius_m > 0.0 ? g.radius_m : std::hypot(g.size_m.x, g.size_m.y) / 2;
+      if (solid.DistanceOutside({g.center_m.x, g.center_m.y}) > reach) continue;
+      if (g.entry == field::Goal::Entry::kEnds || !g.on_object.empty()) hollow = true;
+      for (const auto& [type_name, points] : g.points) {
+        const field::ObjectType* type = season.FindObjectType(type_name);
+        if (type && type->shape == field::ObjectShape::kTorus) hollow = true;
+      }
+    }
+    for (const field::ObjectPlacement& p : season.objects) {
+      const field::ObjectType* type = season.FindObjectType(p.type);
+      if (!type || p.z_m >= solid.z_max_m) continue;  // above it: outside the solid
+      Eigen::Vector2d at;
+      double spread = type->size_m / 2.0;
+      if (p.position_m) {
+        at = {p.position_m->x, p.position_m->y};
+      } else if (p.region && p.z_m > 0.0) {  // drawn on the floor: never inside a structure
+        at = {(p.region->min_m.x + p.region->max_m.x) / 2.0,
+              (p.region->min_m.y + p.region->max_m.y) / 2.0};
+        spread += std::hypot(p.region->max_m.x - p.region->min_m.x,
+                             p.region->max_m.y - p.region->min_m.y) /
+                  2.0;
+      } else {
+        continue;
+      }
+      if (solid.DistanceOutside(at) < spread && p.z_m + type->height_m > solid.z_min_m) {
+        hollow = true;
+      }
+    }
+    if (!hollow) bounds->solids.push_back(solid);
+  }
+}
+
 }  // namespace
 
 FieldBounds FieldBoundsOf(const field::SeasonConfig& season) {
@@ -53,7 +101,16 @@ FieldBounds FieldBoundsOf(const field::SeasonConfig& season) {
     const double r = g.radius_m > 0.0 ? g.radius_m : std::hypot(g.size_m.x, g.size_m.y) / 2.0;
     add({g.center_m.x, g.center_m.y}, Eigen::Vector2d::Constant(r), g.height_m + tallest);
   }
+  AddSolids(season, &bounds);
   return bounds;
+}
+
+double FieldBounds::Solid::DistanceOutside(const Eigen::Vector2d& p) const {
+  const Eigen::Vector2d d = p - centre_m;
+  if (cylinder) return std::max(0.0, d.norm() - radius_m);
+  const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
+  const Eigen::Vector2d local(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+  return (local.cwiseAbs() - half_size_m).cwiseMax(0.0).norm();
 }
 
 std::optional<Measurement> GroundPlaneMeasurement(const CameraModel& camera,
@@ -112,9 +169,9 @@ bool RayMeetsBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction
 
 }  // namespace
 
-bool OnField(const Detection& detection, const CameraModel& camera,
-             const Eigen::Vector3d& robot_pose, const FieldBounds& bounds,
-             const FieldGateOptions& options, const MeasurementOptions& measurement_options) {
+GateVerdict Judge(const Detection& detection, const CameraModel& camera,
+                  const Eigen::Vector3d& robot_pose, const FieldBounds& bounds,
+                  const FieldGateOptions& options, const MeasurementOptions& measurement_options) {
   const double c = std::cos(robot_pose.z()), s = std::sin(robot_pose.z());
   const auto to_world = [&](const Eigen::Vector3d& p) {
     return Eigen::Vector3d(robot_pose.x() + c * p.x() - s * p.y(),
@@ -144,11 +201,42 @@ bool OnField(const Detection& detection, const CameraModel& camera,
     const double sigma = std::sqrt(std::max(0.0, m.covariance(0, 0)) +
                                    m.range_m * m.range_m * std::max(0.0, m.covariance(1, 1)));
     const double across = options.sigmas * std::hypot(sigma, options.pose_sigma_m);
+    bool inside = false;
     for (const auto& [lo, hi] :
          boxes(across, options.sigmas * sigma, -std::numeric_limits<double>::infinity())) {
-      if ((p.array() >= lo.array() - 1e-9).all() && (p.array() <= hi.array()).all()) return true;
+      if ((p.array() >= lo.array() - 1e-9).all() && (p.array() <= hi.array()).all()) {
+        inside = true;
+        break;
+      }
     }
-    return false;
+    if (!inside) return GateVerdict::kOffField;
+    // Without depth the position is the ground plane's, which assumes an object resting on
+    // the floor: it says nothing of whether a structure was seen.
+    if (m.depth_pixels == 0) return GateVerdict::kOnField;
+    // A structure of the detection's colour, where no object can be: the object's centre
+    // inside it (a real object touching one has its centre at least its own half-size
+    // outside), or the measured surface on it within the depth's uncertainty (a thin post or
+    // bar, whose "centre" lands behind it). The pose's uncertainty is left out of the margin:
+    // an error of the pose keeps such a detection rather than dropping a real object.
+    for (const FieldBounds::Solid& solid : bounds.solids) {
+      if (solid.colour != detection.colour || p.z() < solid.z_min_m || p.z() > solid.z_max_m) {
+        continue;
+      }
+      if (solid.DistanceOutside(p.head<2>()) <= 0.0) return GateVerdict::kStructure;
+    }
+    if (m.position_camera_m.z() > 0.0) {  // the median depth's point
+      const Eigen::Vector3d surface = to_world(
+          camera.CameraToRobot(m.position_camera_m * (m.depth_m / m.position_camera_m.z())));
+      const double t = options.sigmas * sigma;
+      for (const FieldBounds::Solid& solid : bounds.solids) {
+        if (solid.colour != detection.colour || surface.z() < solid.z_min_m - t ||
+            surface.z() > solid.z_max_m + t) {
+          continue;
+        }
+        if (solid.DistanceOutside(surface.head<2>()) <= t) return GateVerdict::kStructure;
+      }
+    }
+    return GateVerdict::kOnField;
   }
   // No position: the ray through the detection's lowest pixel (moved down by the pixel
   // uncertainty, which only makes it reach the floor sooner) must pass through one of the
@@ -163,9 +251,16 @@ bool OnField(const Detection& detection, const CameraModel& camera,
   const Eigen::Vector3d direction =
       to_world(camera.CameraToRobot(camera.BackProject(lowest_u, lowest_v, 1.0))) - origin;
   for (const auto& [lo, hi] : boxes(options.sigmas * options.pose_sigma_m, 0.0, 0.0)) {
-    if (RayMeetsBox(origin, direction, lo, hi)) return true;
+    if (RayMeetsBox(origin, direction, lo, hi)) return GateVerdict::kOnField;
   }
-  return false;
+  return GateVerdict::kOffField;
+}
+
+bool OnField(const Detection& detection, const CameraModel& camera,
+             const Eigen::Vector3d& robot_pose, const FieldBounds& bounds,
+             const FieldGateOptions& options, const MeasurementOptions& measurement_options) {
+  return Judge(detection, camera, robot_pose, bounds, options, measurement_options) ==
+         GateVerdict::kOnField;
 }
 
 std::vector<Detection> RejectOffField(const std::vector<Detection>& detections,

@@ -5,9 +5,13 @@
 // the ground plane), one outside the perimeter or above anything the season places; without
 // one, one whose lowest pixel's ray never comes down into the field's box (it looks over the
 // perimeter wall at the stands). The field's size and height come from the season file.
+// With depth, a detection whose centre lies inside a fixed structure of its own colour (a red
+// stash), or whose measured surface lies on one (an alliance-coloured post or bar), is that
+// structure, not an object, and is dropped too.
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,6 +37,22 @@ struct FieldBounds {
     double top_m = 0.0;
   };
   std::vector<Column> raised;
+  // The season's coloured structures an object cannot lie inside: a detection of the same
+  // colour whose centre is in one, or whose surface is on one, is the structure. Left out: those
+  // objects thread onto (a goal scoring a ring) or enter (a goal entered through its ends), and
+  // those an object starts on or in below their top.
+  struct Solid {
+    std::string colour;
+    bool cylinder = false;
+    Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();
+    Eigen::Vector2d half_size_m = Eigen::Vector2d::Zero();  // a box, along its own axes
+    double radius_m = 0.0;                                  // a cylinder
+    double yaw_rad = 0.0;
+    double z_min_m = 0.0, z_max_m = 0.0;
+    // How far (m) the point p (world, x y) is outside the solid's footprint; 0 inside.
+    double DistanceOutside(const Eigen::Vector2d& p) const;
+  };
+  std::vector<Solid> solids;
 };
 FieldBounds FieldBoundsOf(const field::SeasonConfig& season);
 
@@ -53,8 +73,16 @@ std::optional<Measurement> GroundPlaneMeasurement(const CameraModel& camera,
                                                   double centre_height_m,
                                                   const MeasurementOptions& options = {});
 
-// Whether a detection can be an object on the field, seen by `camera` from the robot at
-// `robot_pose` (x_m, y_m, heading_rad; the estimate).
+// What the gate makes of a detection seen by `camera` from the robot at `robot_pose` (x_m,
+// y_m, heading_rad; the estimate): an object on the field, something off it (beyond the
+// perimeter, above where objects can be), or a structure of the detection's own colour.
+enum class GateVerdict { kOnField, kOffField, kStructure };
+GateVerdict Judge(const Detection& detection, const CameraModel& camera,
+                  const Eigen::Vector3d& robot_pose, const FieldBounds& bounds,
+                  const FieldGateOptions& options = {},
+                  const MeasurementOptions& measurement_options = {});
+
+// Whether a detection can be an object on the field: Judge(...) == GateVerdict::kOnField.
 bool OnField(const Detection& detection, const CameraModel& camera,
              const Eigen::Vector3d& robot_pose, const FieldBounds& bounds,
              const FieldGateOptions& options = {},

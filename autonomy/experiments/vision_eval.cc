@@ -261,8 +261,11 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
         const SimObject* object = id ? object_of[id] : nullptr;
         const bool hit = object && object->colour == d.colour && matched.count(id) == 0;
         ++(hit ? s.raw_true_positives : s.raw_false_positives);
-        if (!vision::OnField(d, *setup.camera, gate_pose, bounds, gate, detect.measurement)) {
+        const vision::GateVerdict verdict =
+            vision::Judge(d, *setup.camera, gate_pose, bounds, gate, detect.measurement);
+        if (verdict != vision::GateVerdict::kOnField) {
           ++s.rejected_by_geometry;
+          s.rejected_structure += verdict == vision::GateVerdict::kStructure;
           s.rejected_objects += hit;
           rejected.push_back(&d);
           continue;
@@ -394,9 +397,9 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
 std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores) {
   std::string out;
   char line[320];
-  std::snprintf(line, sizeof(line), "%-19s %9s %8s %8s %6s %6s %6s %6s %7s %7s %8s %9s  %s\n",
-                "method", "precision", "no_gate", "rejected", "wrong", "recall", "solid", "semi",
-                "hidden", "groups", "count_ok", "centre_px",
+  std::snprintf(line, sizeof(line), "%-19s %9s %8s %8s %9s %6s %6s %6s %6s %7s %7s %8s %9s  %s\n",
+                "method", "precision", "no_gate", "rejected", "structure", "wrong", "recall",
+                "solid", "semi", "hidden", "groups", "count_ok", "centre_px",
                 "position error m: <1m  1-2m  2-3m  3m+");
   out += line;
   for (const VisionMethodScore& s : scores) {
@@ -413,11 +416,12 @@ std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores) {
       bands += cell;
     }
     std::snprintf(line, sizeof(line),
-                  "%-19s %9.3f %8.3f %8d %6d %6.3f %6.3f %6.3f %7.3f %7d %8.3f %9.2f  %s\n",
+                  "%-19s %9.3f %8.3f %8d %9d %6d %6.3f %6.3f %6.3f %7.3f %7d %8.3f %9.2f  %s\n",
                   s.name.c_str(), s.Precision(), s.RawPrecision(), s.rejected_by_geometry,
-                  s.rejected_objects, s.Recall(), ratio(s.found_solid, s.expected_solid),
-                  ratio(s.found_semi, s.expected_semi), ratio(s.found_hidden, s.expected_hidden),
-                  s.groups, ratio(s.groups_counted, s.groups),
+                  s.rejected_structure, s.rejected_objects, s.Recall(),
+                  ratio(s.found_solid, s.expected_solid), ratio(s.found_semi, s.expected_semi),
+                  ratio(s.found_hidden, s.expected_hidden), s.groups,
+                  ratio(s.groups_counted, s.groups),
                   s.centre_errors ? s.centre_error_px_sum / s.centre_errors : 0.0, bands.c_str());
     out += line;
   }

@@ -62,6 +62,7 @@ struct VisionMethodScore {
   int raw_false_positives = 0;
   int rejected_by_geometry = 0;  // detections the gate dropped
   int rejected_objects = 0;      // ... of which were objects (wrongly dropped)
+  int rejected_structure = 0;    // ... of which lay inside a structure of their colour
   int expected = 0;  // visible truth objects (enough pixels, mostly unoccluded, in range)
   int found = 0;     // of those, matched
   int expected_hidden = 0, found_hidden = 0;  // enough pixels but mostly hidden
