@@ -11,15 +11,17 @@
 namespace slamo::vision {
 namespace {
 
-// The extent of `values` between the trim quantiles (values is reordered).
-double TrimmedExtent(std::vector<float>* values, double trim) {
+// The extent of `values` between the trim quantiles (values is reordered); `low`, if given,
+// gets the lower quantile.
+double TrimmedExtent(std::vector<float>* values, double trim, double* low = nullptr) {
   if (values->size() < 2) return 0.0;
   const size_t n = values->size();
   const size_t lo = static_cast<size_t>(trim * (n - 1)), hi = n - 1 - lo;
   std::nth_element(values->begin(), values->begin() + lo, values->end());
-  const float low = (*values)[lo];
+  const float bottom = (*values)[lo];
+  if (low) *low = bottom;
   std::nth_element(values->begin(), values->begin() + hi, values->end());
-  return (*values)[hi] - low;
+  return (*values)[hi] - bottom;
 }
 
 }  // namespace
@@ -55,11 +57,14 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   if (points.size() < 8) return result;
 
   // Taller than the tallest stack, or flatter than one object: not objects of this size.
+  // Nor a blob whose bottom is off the floor: the objects rest on it or on one another, and a
+  // raised structure of their colour (a goal's frame, a bar) seen from the side is not a pile.
   std::vector<float> heights(points.size());
   for (size_t i = 0; i < points.size(); ++i) heights[i] = points[i][2];
-  const double height_units = TrimmedExtent(&heights, options.trim_fraction);
+  double bottom = 0.0;
+  const double height_units = TrimmedExtent(&heights, options.trim_fraction, &bottom);
   if (height_units > extent.vertical_limit * std::max(1, extent.max_stack) ||
-      height_units < extent.min_vertical) {
+      height_units < extent.min_vertical || bottom > options.floor_tolerance) {
     return result;
   }
   // Objects rest on the floor or on one another, so the top of the blob lies at a whole

@@ -46,6 +46,9 @@ struct SizeSplitOptions {
   // of heights; each object of the top level at least min_top_depth widths deep on the floor.
   double top_tolerance = 0.2;
   double min_top_depth = 0.35;
+  // The blob's bottom (its 3rd percentile) at most this x the object's height above the floor:
+  // objects rest on it, so a blob raised off it is something else of their colour.
+  double floor_tolerance = 0.5;
   int min_level_points = 4;  // a stack level with fewer footprint cells has no objects of its own
 };
 

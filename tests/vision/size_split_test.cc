@@ -35,6 +35,12 @@ class SizeSplitScene {
   const field::ObjectType& Type(const std::string& name) { return *season_.FindObjectType(name); }
   platform::SimWorld* world() { return &world_; }
 
+  std::vector<Detection> Detections(const Pose2D& pose) {
+    platform::SimRenderer renderer(season_, robot_.camera, platform::RenderOptions{}, 1);
+    const platform::RgbdFrame frame = renderer.Render(world_, pose, 0.0, nullptr);
+    return Detect(frame.colour, frame.depth_mm, setup_, {});
+  }
+
   // Detections of `colour` whose centre or most of whose pixels lie on one of `ids`, per id.
   std::map<int, int> DetectionsOn(const Pose2D& pose, const std::string& colour,
                                   const std::set<int>& ids, int* others = nullptr,
@@ -177,6 +183,29 @@ TEST(SizeSplitTest, PileIsCountedWithinTenPercent) {
     all_visible += visible;
   }
   EXPECT_LE(std::abs(all_counted - all_visible), 0.1 * all_visible);
+}
+
+// Objects rest on the floor or on one another: the same pile lifted off the floor (as a goal's
+// frame of the objects' colour is, seen from the side) is not split by size, while on the
+// floor it is.
+TEST(SizeSplitTest, ABlobOffTheFloorIsNotSplitBySize) {
+  for (double lift_m : {0.0, 0.16, 0.3}) {
+    SizeSplitScene scene("push_back");
+    const field::ObjectType& block = scene.Type("block");
+    const std::vector<int> ids = platform::AddPile(block, "blue", kSpot, 8, scene.world());
+    for (platform::SimObject& o : scene.world()->objects) o.center_m.z() += lift_m;
+    const std::vector<Detection> all =
+        scene.Detections(Facing(kSpot, 1.0 + 3.0 * block.size_m + 0.3));
+    int sized = 0;
+    for (const Detection& d : all) sized += d.colour == "blue" && d.sized;
+    SCOPED_TRACE("lifted " + std::to_string(lift_m) + " m: " + std::to_string(sized) +
+                 " detections split by size");
+    if (lift_m == 0.0) {
+      EXPECT_GE(sized, 4);
+    } else {
+      EXPECT_EQ(sized, 0);
+    }
+  }
 }
 
 // The split alone: an empty or depthless blob gives no groups; one object, one group.
