@@ -504,9 +504,7 @@ std::vector<cv::Mat> ColourMasks(const cv::Mat& bgr, const DetectorSetup& setup,
                                  const DetectOptions& options) {
   std::vector<cv::Mat> masks;
   if (options.method == DetectMethod::kThreshold) {
-    cv::Mat hsv;
-    cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
-    masks = ThresholdHsv(hsv, setup.colours);
+    masks = ThresholdBgr(bgr, setup.colours);  // ThresholdHsv's masks, without the HSV image
   } else {
     std::vector<int> cluster_class;
     cv::Size small_size;
