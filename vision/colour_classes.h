@@ -44,4 +44,8 @@ cv::Mat ThresholdHsv(const cv::Mat& hsv, const ColourClass& colour);
 // ThresholdHsv of each class, the same masks, in one pass over the image.
 std::vector<cv::Mat> ThresholdHsv(const cv::Mat& hsv, const std::vector<ColourClass>& colours);
 
+// The masks ThresholdHsv gives on cv::cvtColor(bgr, COLOR_BGR2HSV), bit for bit, straight
+// from an 8-bit BGR image: OpenCV's integer HSV of each pixel and the windows in one pass.
+std::vector<cv::Mat> ThresholdBgr(const cv::Mat& bgr, const std::vector<ColourClass>& colours);
+
 }  // namespace slamo::vision

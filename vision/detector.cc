@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/circle_fit.h"
 #include "vision/contour_fill.h"
 #include "vision/field_gate.h"
 
@@ -179,27 +180,11 @@ struct ArcFit {
 // four times and needs the statistics of the last fit only.
 std::optional<ArcFit> FitCircle(const std::vector<cv::Point>& points) {
   if (points.size() < 8) return std::nullopt;
-  cv::Point2d mean(0, 0);
-  for (const cv::Point& p : points) mean += cv::Point2d(p);
-  mean *= 1.0 / points.size();
-  const int n = static_cast<int>(points.size());
-  cv::Mat a(n, 3, CV_64F), b(n, 1, CV_64F);
-  for (int i = 0; i < n; ++i) {
-    const double x = points[i].x - mean.x, y = points[i].y - mean.y;
-    double* row = a.ptr<double>(i);
-    row[0] = x;
-    row[1] = y;
-    row[2] = 1.0;
-    b.at<double>(i, 0) = -(x * x + y * y);
-  }
-  cv::Mat solution;
-  if (!cv::solve(a, b, solution, cv::DECOMP_SVD)) return std::nullopt;
-  const double cx = -solution.at<double>(0) / 2.0, cy = -solution.at<double>(1) / 2.0;
-  const double r2 = cx * cx + cy * cy - solution.at<double>(2);
-  if (!(r2 > 0.0)) return std::nullopt;
+  const std::optional<Circle> circle = FitCircleKasa(points);
+  if (!circle) return std::nullopt;
   ArcFit fit;
-  fit.centre = mean + cv::Point2d(cx, cy);
-  fit.radius = std::sqrt(r2);
+  fit.centre = circle->centre;
+  fit.radius = circle->radius;
   return fit;
 }
 
@@ -519,9 +504,7 @@ std::vector<cv::Mat> ColourMasks(const cv::Mat& bgr, const DetectorSetup& setup,
                                  const DetectOptions& options) {
   std::vector<cv::Mat> masks;
   if (options.method == DetectMethod::kThreshold) {
-    cv::Mat hsv;
-    cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
-    masks = ThresholdHsv(hsv, setup.colours);
+    masks = ThresholdBgr(bgr, setup.colours);  // ThresholdHsv's masks, without the HSV image
   } else {
     std::vector<int> cluster_class;
     cv::Size small_size;

@@ -1,9 +1,11 @@
 // Detection per frame, for each method, on a rendered Toss Up view with solid and
 // semi-transparent balls, at the depth camera's 512x424 and at 1920x1080 (the Kinect V2
-// colour resolution). One core.
+// colour resolution); and the threshold's masks alone, by either path. One core.
 #include <benchmark/benchmark.h>
 
 #include <map>
+
+#include <opencv2/imgproc.hpp>
 
 #include "field_configs/loader.h"
 #include "platform/sim/sim_renderer.h"
@@ -52,6 +54,25 @@ void BM_Detect(benchmark::State& state, DetectMethod method, SeparationMethod se
   state.SetLabel(std::to_string(scene.colour.cols) + "x" + std::to_string(scene.colour.rows) +
                  ", " + std::to_string(found) + " found");
 }
+
+// The threshold's masks alone: BGR -> HSV -> windows, and the same masks straight from BGR.
+void BM_Threshold(benchmark::State& state, bool from_bgr) {
+  const Scene& scene = SceneAt(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    std::vector<cv::Mat> masks;
+    if (from_bgr) {
+      masks = ThresholdBgr(scene.colour, scene.setup.colours);
+    } else {
+      cv::Mat hsv;
+      cv::cvtColor(scene.colour, hsv, cv::COLOR_BGR2HSV);
+      masks = ThresholdHsv(hsv, scene.setup.colours);
+    }
+    benchmark::DoNotOptimize(masks.data());
+  }
+}
+
+BENCHMARK_CAPTURE(BM_Threshold, hsv, false)->Arg(512)->Arg(1920)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Threshold, bgr, true)->Arg(512)->Arg(1920)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_CAPTURE(BM_Detect, threshold_defects, DetectMethod::kThreshold,
                   SeparationMethod::kConcaveDefects)
