@@ -448,6 +448,7 @@ DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
       // blocks seen from a low camera are flat shapes.
       k.min_circularity = round ? 0.6 : 0.3;
       k.round = round;
+      k.solid = type.material != field::Material::kSemiTransparent;
       // The tallest stack of this type the season file places (High Stakes' corner rings).
       for (const field::ObjectPlacement& p : season.objects) {
         if (p.type == type.name) k.max_stack = std::max(k.max_stack, p.stack_size);
@@ -781,6 +782,22 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             if (!best) {
               ++st.rejected_size;
               continue;
+            }
+            if (best->round && best->solid && options.min_bulge_ratio > 0.0) {
+              // The bands at the kind's apparent radius at this depth, not the piece's own: a
+              // ball partly hidden behind others shows a smaller piece of the same curve.
+              const double apparent_px =
+                  focal * best->radius_m / (surface->depth_m + best->surface_to_centre_m);
+              const std::optional<SurfaceBulge> bulge =
+                  MeasureSurfaceBulge(depth_roi, piece_mask, d.centre_px - cv::Point2d(roi.tl()),
+                                      std::max(d.radius_px, apparent_px), *setup.camera);
+              // Flat: within the noise of no bulge either way (a piece whose centre reads
+              // deeper than its rims is something else: two objects at different depths).
+              if (bulge && std::abs(bulge->bulge_m) + 3.0 * bulge->sigma_m <
+                               options.min_bulge_ratio * best->radius_m) {
+                ++st.rejected_flat;
+                continue;
+              }
             }
             d.kind = best->name;
             d.measurement = MeasureFromSurface(*surface, d.centre_px, best->surface_to_centre_m,

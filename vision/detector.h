@@ -51,6 +51,12 @@ struct DetectOptions {
   double max_arc_rms_ratio = 0.1;
   double min_arc_coverage_deg = 120.0;
   double min_arc_inlier_fraction = 0.5;  // share of the outline on the circle
+  // With depth, a detection typed as a round solid kind must curve away from the camera
+  // (vision/measurement.h MeasureSurfaceBulge): it is dropped as a flat face (a wall, a
+  // robot's bumper) when its rims' bulge, plus 3 sigma of the depth noise, stays under this x
+  // the kind's radius. A sphere's is about 0.28; a triball's least, a face turned to the
+  // camera (a sphere of its width), about 0.12. 0 turns the test off.
+  double min_bulge_ratio = 0.1;
   // K-Means (thesis 5.2.2): clustering of the chromatic pixels in Lab a*b*.
   int kmeans_downsample = 0;           // cluster on an image this many times smaller; 0: about
                                        // 256 px wide (2x at 512x424, 8x at 1920x1080)
@@ -71,6 +77,7 @@ struct TargetKind {
   double centre_height_m = 0.0;      // the centre above the floor, resting on it (0: unknown)
   double min_circularity = 0.6;      // 4 pi A / P^2 of an unoccluded view (flat kinds)
   bool round = true;                 // looks like a disc from anywhere: judged by a circle fit
+  bool solid = true;                 // depth reads its surface (not semi-transparent)
   int max_stack = 1;                 // most of them one on top of another (the season's
                                      // tallest stack placed)
 };
@@ -114,6 +121,7 @@ struct DetectStats {
   int rejected_small = 0;
   int rejected_shape = 0;
   int rejected_size = 0;
+  int rejected_flat = 0;  // round solid kinds whose surface does not curve (a bumper's face)
   int split_by_size = 0;  // blobs separated by the objects' known size
   int without_depth = 0;  // kept, but no range: no valid depth on them (or, without a depth
                           // image, no kind resting on the floor fits their size)

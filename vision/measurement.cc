@@ -98,6 +98,49 @@ std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv:
   return BlobSurface{surface_m, static_cast<int>(count)};
 }
 
+std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
+                                                const cv::Point2d& centre_px, double radius_px,
+                                                const CameraModel& camera) {
+  constexpr int kMinReadings = 4;
+  if (depth_mm.empty() || depth_mm.type() != CV_16UC1 || blob_mask.size() != depth_mm.size() ||
+      !(radius_px > 0.0)) {
+    return std::nullopt;
+  }
+  std::vector<uint16_t> bands[3];  // left rim, centre, right rim
+  const int v0 = std::max(0, static_cast<int>(std::ceil(centre_px.y - 0.35 * radius_px)));
+  const int v1 =
+      std::min(depth_mm.rows - 1, static_cast<int>(std::floor(centre_px.y + 0.35 * radius_px)));
+  const int u0 = std::max(0, static_cast<int>(std::ceil(centre_px.x - 0.85 * radius_px)));
+  const int u1 =
+      std::min(depth_mm.cols - 1, static_cast<int>(std::floor(centre_px.x + 0.85 * radius_px)));
+  for (int v = v0; v <= v1; ++v) {
+    const uint8_t* m = blob_mask.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    for (int u = u0; u <= u1; ++u) {
+      if (!m[u] || !d[u]) continue;
+      const double x = (u - centre_px.x) / radius_px;
+      if (std::abs(x) <= 0.3) {
+        bands[1].push_back(d[u]);
+      } else if (std::abs(x) >= 0.55) {
+        bands[x < 0.0 ? 0 : 2].push_back(d[u]);
+      }
+    }
+  }
+  double depth[3], variance[3];
+  for (int b = 0; b < 3; ++b) {
+    if (static_cast<int>(bands[b].size()) < kMinReadings) return std::nullopt;
+    depth[b] = camera.CorrectDepthM(MedianReading(bands[b].data(), bands[b].size()));
+    if (!(depth[b] > 0.0)) return std::nullopt;
+    // The median of n readings: about 1.25 sigma / sqrt(n).
+    const double s = 1.25 * camera.DepthSigmaM(depth[b]);
+    variance[b] = s * s / static_cast<double>(bands[b].size());
+  }
+  SurfaceBulge out;
+  out.bulge_m = (depth[0] + depth[2]) / 2.0 - depth[1];
+  out.sigma_m = std::sqrt(variance[1] + (variance[0] + variance[2]) / 4.0);
+  return out;
+}
+
 Measurement MeasureFromSurface(const BlobSurface& surface, const cv::Point2d& centre_px,
                                double surface_to_centre_m, double radius_px,
                                const CameraModel& camera, const MeasurementOptions& options) {

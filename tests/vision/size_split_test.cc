@@ -12,6 +12,7 @@
 #include "platform/sim/sim_renderer.h"
 #include "platform/sim/sim_world.h"
 #include "vision/detector.h"
+#include "vision/measurement.h"
 
 namespace slamo::vision {
 namespace {
@@ -205,6 +206,63 @@ TEST(SizeSplitTest, ABlobOffTheFloorIsNotSplitBySize) {
     } else {
       EXPECT_EQ(sized, 0);
     }
+  }
+}
+
+// The bulge test of round kinds (vision/measurement.h MeasureSurfaceBulge), on rendered depth
+// with the thesis camera's noise: a ball's surface curves away from the camera by about 0.28
+// of its radius between the centre and the rim bands; a flat face (the perimeter wall, seen
+// square and at 45 degrees) by nothing, within the noise.
+TEST(SurfaceBulgeTest, ABallCurvesAwayAndAWallDoesNot) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("over_under");
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  const CameraModel camera(robot.camera);
+  const field::ObjectType& triball = *season.FindObjectType("triball");
+  const double radius_m = triball.size_m / 2.0;
+  for (double range : {0.8, 1.5, 2.5}) {
+    platform::SimWorld world = platform::CreateWorld(season, 1);
+    world.objects.clear();
+    const std::vector<int> ids = platform::AddStack(triball, "green", kSpot, 1, &world);
+    platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 1);
+    platform::FrameTruth truth;
+    const platform::RgbdFrame frame = renderer.Render(world, Facing(kSpot, range), 0.0, &truth);
+    const cv::Mat mask = truth.ids == ids.front();
+    const cv::Moments m = cv::moments(mask, true);
+    ASSERT_GT(m.m00, 40.0);
+    const cv::Point2d centre(m.m10 / m.m00, m.m01 / m.m00);
+    const std::optional<SurfaceBulge> bulge =
+        MeasureSurfaceBulge(frame.depth_mm, mask, centre, std::sqrt(m.m00 / M_PI), camera);
+    SCOPED_TRACE("ball at " + std::to_string(range) + " m");
+    ASSERT_TRUE(bulge.has_value());
+    EXPECT_NEAR(bulge->bulge_m / radius_m, 0.28, 0.08);
+    EXPECT_LT(3.0 * bulge->sigma_m, 0.1 * radius_m);
+  }
+  // The wall at -y, from 1 m, square on and turned 45 degrees: a disc in the middle of the
+  // wall's band in the image (the first rows of the centre column with depth, from the top).
+  for (double turn : {0.0, M_PI / 4.0}) {
+    platform::SimWorld world = platform::CreateWorld(season, 1);
+    world.objects.clear();
+    const double wall_y = -season.HalfSize();
+    platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 1);
+    const double heading = -M_PI / 2.0 + turn;
+    const platform::Pose2D pose{0.9 - std::cos(heading), wall_y - std::sin(heading), heading};
+    const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, nullptr);
+    const int u = frame.depth_mm.cols / 2;
+    int top = 0;
+    while (top < frame.depth_mm.rows && frame.depth_mm.at<uint16_t>(top, u) == 0) ++top;
+    int bottom = top;
+    while (bottom < frame.depth_mm.rows && frame.depth_mm.at<uint16_t>(bottom, u) != 0) ++bottom;
+    const double radius_px = std::min(20.0, (bottom - top) / 2.0 - 2.0);
+    SCOPED_TRACE("wall turned " + std::to_string(turn) + ": band rows " + std::to_string(top) +
+                 "-" + std::to_string(bottom));
+    ASSERT_GT(radius_px, 8.0);
+    cv::Mat mask(frame.depth_mm.size(), CV_8UC1, cv::Scalar(0));
+    const cv::Point2d centre(u, (top + bottom) / 2.0);
+    cv::circle(mask, centre, static_cast<int>(radius_px), cv::Scalar(255), cv::FILLED);
+    const std::optional<SurfaceBulge> bulge =
+        MeasureSurfaceBulge(frame.depth_mm, mask, centre, radius_px, camera);
+    ASSERT_TRUE(bulge.has_value());
+    EXPECT_LT(std::abs(bulge->bulge_m) + 3.0 * bulge->sigma_m, 0.1 * radius_m);
   }
 }
 
