@@ -229,8 +229,11 @@ GateVerdict Judge(const Detection& detection, const CameraModel& camera,
           camera.CameraToRobot(m.position_camera_m * (m.depth_m / m.position_camera_m.z())));
       const double t = options.sigmas * sigma;
       for (const FieldBounds::Solid& solid : bounds.solids) {
-        if (solid.colour != detection.colour || surface.z() < solid.z_min_m - t ||
-            surface.z() > solid.z_max_m + t) {
+        // Across, the depth's uncertainty; up and down, none: an object resting on top of a
+        // structure of its colour (a ball on a stash) or under one (a triball under a goal's
+        // frame) has its surface just beyond it.
+        if (solid.colour != detection.colour || surface.z() < solid.z_min_m ||
+            surface.z() > solid.z_max_m) {
           continue;
         }
         if (solid.DistanceOutside(surface.head<2>()) <= t) return GateVerdict::kStructure;

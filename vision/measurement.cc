@@ -135,8 +135,10 @@ std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const c
     const double s = 1.25 * camera.DepthSigmaM(depth[b]);
     variance[b] = s * s / static_cast<double>(bands[b].size());
   }
+  // In inverse depth, which is linear across the image for any plane (depth itself is not: a
+  // face turned well away from the camera would read as curved), scaled back to metres.
   SurfaceBulge out;
-  out.bulge_m = (depth[0] + depth[2]) / 2.0 - depth[1];
+  out.bulge_m = depth[1] * depth[1] * (1.0 / depth[1] - (1.0 / depth[0] + 1.0 / depth[2]) / 2.0);
   out.sigma_m = std::sqrt(variance[1] + (variance[0] + variance[2]) / 4.0);
   return out;
 }

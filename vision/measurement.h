@@ -59,11 +59,12 @@ Measurement MeasureFromSurface(const BlobSurface& surface, const cv::Point2d& ce
 // How much deeper a round object's surface reads at its left and right rims than at its
 // centre, along the rows through its centre: a ball's cap curves away from the camera (about
 // 0.28 x its radius between the bands used here), a flat face (a wall, a robot's bumper) does
-// not, whatever its angle (a slope adds as much on one side as it takes on the other).
+// not, whatever its angle: compared in inverse depth, which is linear across the image for a
+// plane (a slope adds as much on one side as it takes on the other).
 // Bands, in x the apparent radius: rows within 0.35 of the centre; the centre |u| <= 0.3, the
 // rims 0.55 <= |u| <= 0.85. `centre_px` is in the mask's own pixels (not the full image's).
 struct SurfaceBulge {
-  double bulge_m = 0.0;  // mean of the two rims' median depths minus the centre's
+  double bulge_m = 0.0;  // the rims' mean inverse median depth below the centre's, x depth^2
   double sigma_m = 0.0;  // its standard deviation from the camera's depth noise
 };
 std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const cv::Mat& blob_mask,

@@ -57,8 +57,10 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   if (points.size() < 8) return result;
 
   // Taller than the tallest stack, or flatter than one object: not objects of this size.
-  // Nor a blob whose bottom is off the floor: the objects rest on it or on one another, and a
-  // raised structure of their colour (a goal's frame, a bar) seen from the side is not a pile.
+  // Nor a blob whose bottom is off the floor: a raised structure of the objects' colour (a
+  // goal's frame, a bar) seen from the side is not a pile. A trade-off: piles off the floor
+  // (rings on a stake, blocks in a raised goal, balls on a stash) or whose lower part is hidden
+  // (behind a barrier, below the image) are not split by size either.
   std::vector<float> heights(points.size());
   for (size_t i = 0; i < points.size(); ++i) heights[i] = points[i][2];
   double bottom = 0.0;
