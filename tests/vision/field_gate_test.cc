@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -190,7 +191,7 @@ TEST_F(FieldGateTest, SolidsAreTheColouredStructuresObjectsCannotBeIn) {
 // Against the renderer: seen from the middle zone with the barrier's pipe across it, the red
 // stash's top half passes the detector for a red ball (tests/vision/detector_test.cc); its
 // centre lies inside the stash, where no object can be, so the gate drops it. A red ball
-// resting against the stash, and one scored on top of it, stay.
+// beside the stash, and one scored on top of it, are both seen and kept.
 TEST_F(FieldGateTest, ADetectionInsideAStructureOfItsColourIsThatStructure) {
   platform::SimWorld world = platform::CreateWorld(season_, 5);
   const auto ball = [&](int id, const std::string& type, double x, double y, double z) {
@@ -202,7 +203,9 @@ TEST_F(FieldGateTest, ADetectionInsideAStructureOfItsColourIsThatStructure) {
     return o;
   };
   const double buckyball = season_.FindObjectType("buckyball")->size_m;
-  // Against the stash's near side (radius 0.14), and a large ball stashed on its top (0.61).
+  // Beside the stash's near side (radius 0.14; 8 cm from it, off to one side: a ball touching
+  // it straight in front merges with the stash's blob and is not detected at all, a limit of
+  // the detector, not of the gate), and a large ball stashed on its top (0.61).
   world.objects = {ball(1, "buckyball", 0.78 - 0.14 - buckyball / 2.0 - 0.005, 0.42, 0.0),
                    ball(2, "large_ball", 0.78, 0.61, 0.61)};
   const FieldBounds::Solid* stash = nullptr;
@@ -218,7 +221,8 @@ TEST_F(FieldGateTest, ADetectionInsideAStructureOfItsColourIsThatStructure) {
   const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, &truth);
   DetectOptions kmeans;  // the large ball is semi-transparent
   kmeans.method = DetectMethod::kKMeans;
-  int on_stash = 0, dropped_on_stash = 0, balls_kept = 0;
+  int on_stash = 0, dropped_on_stash = 0;
+  std::set<int> balls_kept;
   for (const Detection& d :
        Detect(frame.colour, frame.depth_mm, ObjectDetectorSetup(season_, &robot_.camera), kmeans)) {
     if (d.colour != "red" || !d.measurement) continue;
@@ -227,7 +231,7 @@ TEST_F(FieldGateTest, ADetectionInsideAStructureOfItsColourIsThatStructure) {
     const int id = truth.ids.at<uint16_t>(centre);
     const bool on = OnField(d, camera_, {pose.x_m, pose.y_m, pose.theta_rad}, bounds_);
     if (id == 1 || id == 2) {
-      balls_kept += on;
+      if (on) balls_kept.insert(id);
       EXPECT_TRUE(on) << "ball " << id << " at " << d.centre_px;
       continue;
     }
@@ -243,7 +247,7 @@ TEST_F(FieldGateTest, ADetectionInsideAStructureOfItsColourIsThatStructure) {
   }
   EXPECT_GT(on_stash, 0) << "the detector's weakness this test is about no longer shows";
   EXPECT_EQ(dropped_on_stash, on_stash);
-  EXPECT_EQ(balls_kept, 2);
+  EXPECT_EQ(balls_kept.size(), 2u) << "both balls seen and kept";
 }
 
 // Item 2's last part: without depth, a ball on the floor gets its type from its apparent
