@@ -286,4 +286,74 @@ std::vector<LandmarkPoint> ReadLandmarkCsv(const std::string& path) {
   return landmarks;
 }
 
+namespace {
+
+// The numeric rows of a whitespace-separated file, `%` lines skipped; each row has at least
+// `min_fields` finite numbers (errors name the file and the line). Calls `row` with the
+// 1-based line number and the numbers.
+template <typename RowFn>
+void ReadNumericRows(const std::string& path, size_t min_fields, const char* expected, RowFn row) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::string line;
+  for (int line_number = 1; std::getline(in, line); ++line_number) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '%') continue;
+    const std::vector<std::string> fields = Split(line, ' ');
+    if (fields.size() < min_fields) {
+      throw FileError(path, line_number,
+                      std::string("expected `") + expected + "`, found " +
+                          std::to_string(fields.size()) + " fields");
+    }
+    std::vector<double> v(fields.size());
+    for (size_t i = 0; i < fields.size(); ++i) {
+      if (!ParseFinite(fields[i], &v[i])) {
+        throw FileError(
+            path, line_number,
+            "field " + std::to_string(i + 1) + " `" + fields[i] + "` is not a finite number");
+      }
+    }
+    row(line_number, v);
+  }
+}
+
+}  // namespace
+
+std::vector<SimulLandmarksPose> ReadSimulLandmarksPath(const std::string& path) {
+  std::vector<SimulLandmarksPose> poses;
+  ReadNumericRows(path, 4, "x y z yaw pitch roll", [&](int, const std::vector<double>& v) {
+    poses.push_back({v[0], v[1], v[3]});
+  });
+  return poses;
+}
+
+std::vector<LandmarkPoint> ReadSimulLandmarksMap(const std::string& path) {
+  std::vector<LandmarkPoint> landmarks;
+  ReadNumericRows(path, 7, "x y z a b c id", [&](int line_number, const std::vector<double>& v) {
+    if (v[6] != std::floor(v[6]) || v[6] < 0 || v[6] > std::numeric_limits<int>::max()) {
+      throw FileError(path, line_number, "the id (field 7) is not an integer >= 0");
+    }
+    landmarks.push_back({static_cast<int>(v[6]), v[0], v[1]});
+  });
+  return landmarks;
+}
+
+TruthFormat DetectTruthFormat(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos) continue;
+    if (line[first] == '%') return TruthFormat::kSimulLandmarksPath;
+    if (line[first] == '#' || line.find(',') != std::string::npos) return TruthFormat::kTumOrCsv;
+    const std::vector<std::string> fields = Split(line, ' ');
+    double v;
+    const bool numeric = std::all_of(fields.begin(), fields.end(),
+                                     [&](const std::string& f) { return ParseFinite(f, &v); });
+    return numeric && fields.size() == 7 ? TruthFormat::kSimulLandmarksMap : TruthFormat::kTumOrCsv;
+  }
+  return TruthFormat::kTumOrCsv;
+}
+
 }  // namespace slamo::mapping

@@ -98,4 +98,27 @@ LandmarkError LandmarkRmse(const std::vector<LandmarkPoint>& truth,
 // command's landmarks.csv has the covariance in the extra columns). Errors name file and line.
 std::vector<LandmarkPoint> ReadLandmarkCsv(const std::string& path);
 
+// The truth MRPT's `simul-landmarks` writes beside its rawlog `X`:
+// - `X_ground_truth_robot_path.txt`: `%` comment lines, then `x y z yaw pitch roll` per step:
+//   row k (from 0) is the pose where the rawlog's k-th observation was taken, after k odometry
+//   steps; the last odometry step leads to a pose without a row (no timestamps, so a replay
+//   pairs the rows with its trajectory step by step);
+// - `X_ground_truth.txt`: `x y z a b c id` per landmark, the id the one the rawlog's
+//   observations carry.
+// Errors name the file and the line.
+struct SimulLandmarksPose {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+};
+std::vector<SimulLandmarksPose> ReadSimulLandmarksPath(const std::string& path);
+std::vector<LandmarkPoint> ReadSimulLandmarksMap(const std::string& path);
+
+// Which of the formats above a truth file is in, by its first line that is not blank: `%`
+// opens simul-landmarks' robot path; a line of numbers without commas is simul-landmarks'
+// landmark map; anything else is TUM (trajectories) or CSV (landmarks). Throws
+// std::runtime_error naming the file when it cannot be opened.
+enum class TruthFormat { kTumOrCsv, kSimulLandmarksPath, kSimulLandmarksMap };
+TruthFormat DetectTruthFormat(const std::string& path);
+
 }  // namespace slamo::mapping

@@ -291,11 +291,31 @@ int Run(const ReplayArgs& cli) {
   // trajectory alignment gives (no alignment when only the landmark truth is known).
   mapping::Rigid2d alignment;
   if (!args.truth.empty()) {
-    const std::vector<mapping::TimedPose> truth = mapping::ReadTumTrajectory(args.truth);
-    const mapping::AteResult ate =
-        mapping::AbsoluteTrajectoryError(truth, trajectory, args.max_dt_s, /*align=*/true);
-    const mapping::AteResult raw =
-        mapping::AbsoluteTrajectoryError(truth, trajectory, args.max_dt_s, /*align=*/false);
+    mapping::AteResult ate, raw;
+    if (mapping::DetectTruthFormat(args.truth) == mapping::TruthFormat::kSimulLandmarksPath) {
+      // simul-landmarks' path has no times. Its row k is the pose where the k-th observation
+      // was taken, after k odometry steps: the replay's pose k - 1 (the last step, after the
+      // last observation, has no row).
+      const std::vector<mapping::SimulLandmarksPose> path =
+          mapping::ReadSimulLandmarksPath(args.truth);
+      if (path.size() != trajectory.size()) {
+        std::cerr << "error: " << args.truth << ": " << path.size()
+                  << " poses, but simul-landmarks writes one per odometry step of the log: "
+                  << trajectory.size() << "\n";
+        return 2;
+      }
+      std::vector<Eigen::Vector2d> truth, estimate;
+      for (size_t k = 1; k < path.size(); ++k) {
+        truth.emplace_back(path[k].x_m, path[k].y_m);
+        estimate.emplace_back(trajectory[k - 1].x_m, trajectory[k - 1].y_m);
+      }
+      ate = mapping::PairedTrajectoryError(truth, estimate, /*align=*/true);
+      raw = mapping::PairedTrajectoryError(truth, estimate, /*align=*/false);
+    } else {
+      const std::vector<mapping::TimedPose> truth = mapping::ReadTumTrajectory(args.truth);
+      ate = mapping::AbsoluteTrajectoryError(truth, trajectory, args.max_dt_s, /*align=*/true);
+      raw = mapping::AbsoluteTrajectoryError(truth, trajectory, args.max_dt_s, /*align=*/false);
+    }
     alignment = ate.alignment;
     std::printf(
         "ATE %.4f m RMSE (mean %.4f, median %.4f, max %.4f) over %d poses, aligned by "
@@ -309,8 +329,11 @@ int Run(const ReplayArgs& cli) {
     for (int i = 0; i < ekf.landmark_count(); ++i) {
       estimate.push_back({ekf.landmark_id(i), ekf.landmark(i).x(), ekf.landmark(i).y()});
     }
-    const mapping::LandmarkError error =
-        mapping::LandmarkRmse(mapping::ReadLandmarkCsv(args.landmarks_truth), estimate, alignment);
+    const std::vector<mapping::LandmarkPoint> truth =
+        mapping::DetectTruthFormat(args.landmarks_truth) == mapping::TruthFormat::kSimulLandmarksMap
+            ? mapping::ReadSimulLandmarksMap(args.landmarks_truth)
+            : mapping::ReadLandmarkCsv(args.landmarks_truth);
+    const mapping::LandmarkError error = mapping::LandmarkRmse(truth, estimate, alignment);
     std::printf("landmark RMSE %.4f m over %d landmarks (%d in the truth not mapped)%s\n",
                 error.rmse_m, error.pairs, error.missing,
                 args.truth.empty() ? ", unaligned" : ", after the trajectory alignment");
@@ -328,9 +351,13 @@ void RegisterReplayCommand(CLI::App& app, CommandAction* action) {
       "e.g. slamo replay --log run.log --truth truth.tum --out DIR");
   replay->add_option("--log", args->log, "recorded run: text log (mapping/README.md) or .rawlog")
       ->required();
-  replay->add_option("--truth", args->truth, "true trajectory, TUM format: prints the ATE");
+  replay->add_option(
+      "--truth", args->truth,
+      "true trajectory, TUM format, or simul-landmarks' X_ground_truth_robot_path.txt "
+      "(paired step by step): prints the ATE");
   replay->add_option("--landmarks-truth", args->landmarks_truth,
-                     "true landmarks, CSV id,x_m,y_m: prints the landmark RMSE");
+                     "true landmarks, CSV id,x_m,y_m, or simul-landmarks' X_ground_truth.txt: "
+                     "prints the landmark RMSE");
   replay->add_option("--out", args->out, "directory for trajectory.tum and landmarks.csv");
   replay->add_option("--max-dt", args->max_dt_s, "ATE: largest time difference of a pose pair, s")
       ->capture_default_str();
@@ -382,6 +409,9 @@ void RegisterReplayCommand(CLI::App& app, CommandAction* action) {
   replay->footer(
       "Examples:\n"
       "  slamo replay --log run.rawlog --truth t.tum --landmarks-truth l.csv\n"
+      "  slamo replay --log OUT/gen.rawlog --truth OUT/gen.rawlog_ground_truth_robot_path.txt \\\n"
+      "               --landmarks-truth OUT/gen.rawlog_ground_truth.txt   (MRPT's "
+      "simul-landmarks)\n"
       "  slamo replay --log run.rawlog --motion-per-m 0.3 --range-sigma 0.05 --known-ids false\n"
       "  slamo replay --log run.log --filter-config robot.yaml --out DIR\n"
       "  robot.yaml:  motion_per_m: 0.3\n"

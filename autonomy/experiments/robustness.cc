@@ -51,30 +51,13 @@ void WriteIni(const std::string& path, const RobustnessOptions& o, const Robustn
   if (!out) throw std::runtime_error(path + ": cannot write");
 }
 
-// The rows of one of simul-landmarks' text files (`%` comments skipped).
-std::vector<std::vector<double>> ReadColumns(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open (did simul-landmarks run?)");
-  std::vector<std::vector<double>> rows;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '%') continue;
-    std::istringstream fields(line);
-    std::vector<double> row;
-    double v;
-    while (fields >> v) row.push_back(v);
-    if (!row.empty()) rows.push_back(row);
-  }
-  return rows;
-}
-
 // The generated run as a peer scenario: step 0 holds what is seen before the first move, step
 // k the k-th odometry increment and what is seen after it, with the truth after it (line k
 // of the path file); both filters are told the options' noise, whatever the truth was.
 PeerScenario ScenarioFrom(const std::string& dir, const PeerBenchOptions& told) {
   const mapping::ReplayLog log = mapping::ReadRawlog(dir + "/OUT/gen.rawlog");
-  const std::vector<std::vector<double>> path =
-      ReadColumns(dir + "/OUT/gen.rawlog_ground_truth_robot_path.txt");
+  const std::vector<mapping::SimulLandmarksPose> path =
+      mapping::ReadSimulLandmarksPath(dir + "/OUT/gen.rawlog_ground_truth_robot_path.txt");
   const Eigen::Matrix3d q = PeerStepCovariance(told);
   const Eigen::Matrix2d r = Eigen::Vector2d(told.sigma_range_m * told.sigma_range_m,
                                             told.sigma_bearing_rad * told.sigma_bearing_rad)
@@ -96,8 +79,7 @@ PeerScenario ScenarioFrom(const std::string& dir, const PeerBenchOptions& told) 
   if (path.size() < 2) throw std::runtime_error(dir + ": simul-landmarks wrote no robot path");
   if (scenario.steps.size() > path.size()) scenario.steps.resize(path.size());
   for (size_t k = 0; k < scenario.steps.size(); ++k) {
-    if (path[k].size() < 4) throw std::runtime_error(dir + ": a robot path line without a yaw");
-    scenario.steps[k].truth = Eigen::Vector3d(path[k][0], path[k][1], path[k][3]);
+    scenario.steps[k].truth = Eigen::Vector3d(path[k].x_m, path[k].y_m, path[k].yaw_rad);
   }
   return scenario;
 }
@@ -179,10 +161,8 @@ std::vector<RobustnessRow> RunRobustness(const RobustnessOptions& options,
                                  " (see simul-landmarks.log there)");
       }
       const PeerScenario scenario = ScenarioFrom(dir, told);
-      std::vector<mapping::LandmarkPoint> landmarks;
-      for (const std::vector<double>& l : ReadColumns(dir + "/OUT/gen.rawlog_ground_truth.txt")) {
-        if (l.size() >= 7) landmarks.push_back({static_cast<int>(l[6]), l[0], l[1]});
-      }
+      const std::vector<mapping::LandmarkPoint> landmarks =
+          mapping::ReadSimulLandmarksMap(dir + "/OUT/gen.rawlog_ground_truth.txt");
       int measurements = 0;
       for (const PeerStep& s : scenario.steps)
         measurements += static_cast<int>(s.measurements.size());

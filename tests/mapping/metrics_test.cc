@@ -194,5 +194,77 @@ TEST(LandmarkCsvTest, ReadsWithOrWithoutAHeader) {
   }
 }
 
+// The truth files MRPT's simul-landmarks writes, as it writes them (headers and spacing from a
+// run of simul-landmarks 2.x), told apart from TUM and CSV by their first line.
+TEST(SimulLandmarksTruthTest, ReadsThePathAndTheMapAndTellsTheFormats) {
+  const std::string path_file = TempPath("gen.rawlog_ground_truth_robot_path.txt");
+  const std::string map_file = TempPath("gen.rawlog_ground_truth.txt");
+  {
+    std::ofstream out(path_file);
+    out << "% Columns are: x(m) y(m) z(m) yaw(rad) pitch(rad) roll(rad)\n"
+           "% File generated with mrpt-math at Thu Dec  3 10:53:42 2026\n\n"
+           "%------------------------------------\n"
+           "0.0000000000000000 0.0000000000000000 0.0000000000000000 0.0000000000000000 "
+           "-0.0000000000000000 0.0000000000000000\n"
+           "0.5 0.25 0 1.5707963267948966 0 0\n";
+  }
+  {
+    std::ofstream out(map_file);
+    out << "  7.525192  11.957772   0.000000    5    0   0.000000 1 \n"
+           " -1.950009  -2.998284   0.000000    5    0   0.000000 2 \n";
+  }
+  EXPECT_EQ(DetectTruthFormat(path_file), TruthFormat::kSimulLandmarksPath);
+  EXPECT_EQ(DetectTruthFormat(map_file), TruthFormat::kSimulLandmarksMap);
+  const std::vector<SimulLandmarksPose> path = ReadSimulLandmarksPath(path_file);
+  ASSERT_EQ(path.size(), 2u);
+  EXPECT_DOUBLE_EQ(path[1].x_m, 0.5);
+  EXPECT_DOUBLE_EQ(path[1].y_m, 0.25);
+  EXPECT_DOUBLE_EQ(path[1].yaw_rad, M_PI / 2);
+  const std::vector<LandmarkPoint> map = ReadSimulLandmarksMap(map_file);
+  ASSERT_EQ(map.size(), 2u);
+  EXPECT_EQ(map[0].id, 1);
+  EXPECT_DOUBLE_EQ(map[1].x_m, -1.950009);
+  EXPECT_DOUBLE_EQ(map[1].y_m, -2.998284);
+
+  // TUM and CSV stay theirs.
+  const std::string tum = TempPath("simul_tum.tum");
+  WriteTumTrajectory(tum, Path(3), "true pose");
+  EXPECT_EQ(DetectTruthFormat(tum), TruthFormat::kTumOrCsv);
+  {
+    std::ofstream out(tum);
+    out << "0.1 1 2 0 0 0 0 1\n";  // no header
+  }
+  EXPECT_EQ(DetectTruthFormat(tum), TruthFormat::kTumOrCsv);
+  const std::string csv = TempPath("simul_landmarks.csv");
+  {
+    std::ofstream out(csv);
+    out << "0,1.5,-2\n";
+  }
+  EXPECT_EQ(DetectTruthFormat(csv), TruthFormat::kTumOrCsv);
+
+  // Bad lines are named.
+  {
+    std::ofstream out(map_file);
+    out << "1 2 0 5 0 0 3\n1 2 0 5 0 0 2.5\n";
+  }
+  try {
+    ReadSimulLandmarksMap(map_file);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(":2: the id"), std::string::npos) << e.what();
+  }
+  {
+    std::ofstream out(path_file);
+    out << "% x y z yaw pitch roll\n0 0 0\n";
+  }
+  try {
+    ReadSimulLandmarksPath(path_file);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(":2: expected"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(DetectTruthFormat(TempPath("no_such_truth.txt")), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace slamo::mapping
