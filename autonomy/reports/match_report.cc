@@ -297,7 +297,7 @@ cv::Mat DrawMatchMap(const MatchResult& r) {
   }
   // Legend and figures on the right.
   const cv::Point origin = canvas.ToPixel(r.field.HalfSize(), r.field.HalfSize());
-  int x = origin.x + 40, y = origin.y + 10;
+  int x = origin.x + 60, y = origin.y + 10;  // clear of the right wall's landmark labels
   const auto line = [&](const std::string& text, cv::Scalar colour = cv::Scalar(20, 20, 20)) {
     Text(image, text, cv::Point(x, y += 22), 0.45, colour);
   };
