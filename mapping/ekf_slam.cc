@@ -249,50 +249,69 @@ void EkfSlam::RecordNis(double nis) {
   nis_window_.clear();
 }
 
-void EkfSlam::CheckStep() {
-  const AdaptiveOptions& a = options_.adaptive;
-  const int m = static_cast<int>(step_seen_.size());
-  if (m < 2) {
-    step_seen_.clear();
-    return;
-  }
-  // The pose that best explains this step's measurements alone (Gauss-Newton from the
-  // estimate), against the landmarks as they were before these measurements updated them (so
-  // that the residual is not shrunk by its own update); each measurement weighted by its noise
-  // and its landmark's uncertainty.
-  Eigen::Vector3d pose = x_.head<3>();
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  double chi2 = 0.0;
-  for (int iteration = 0; iteration < 6; ++iteration) {
+std::optional<EkfSlam::SnapshotFit> EkfSlam::FitSnapshot(const std::vector<Seen>& seen,
+                                                         int skip) const {
+  SnapshotFit fit{x_.head<3>(), Eigen::Matrix3d::Zero(), 0.0};
+  for (int iteration = 0; iteration < 10; ++iteration) {
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
-    information.setZero();
-    chi2 = 0.0;
-    for (const Seen& seen : step_seen_) {
+    fit.information.setZero();
+    fit.chi2 = 0.0;
+    for (int j = 0; j < static_cast<int>(seen.size()); ++j) {
+      if (j == skip) continue;
+      const Seen& s = seen[j];
       Eigen::Matrix<double, 2, 3> h_pose;
       Eigen::Matrix2d h_l;
-      ObserveJacobians(pose, seen.landmark, &h_pose, &h_l);
-      const Eigen::Matrix2d w =
-          (NoiseOf(seen.z) + h_l * seen.covariance * h_l.transpose()).inverse();
+      ObserveJacobians(fit.pose, s.landmark, &h_pose, &h_l);
+      const Eigen::Matrix2d w = (NoiseOf(s.z) + h_l * s.covariance * h_l.transpose()).inverse();
       Eigen::Vector2d e =
-          Eigen::Vector2d(seen.z.range_m, seen.z.bearing_rad) - Observe(pose, seen.landmark);
+          Eigen::Vector2d(s.z.range_m, s.z.bearing_rad) - Observe(fit.pose, s.landmark);
       e.y() = Wrap(e.y());
-      information += h_pose.transpose() * w * h_pose;
+      fit.information += h_pose.transpose() * w * h_pose;
       b += h_pose.transpose() * w * e;
-      chi2 += e.dot(w * e);
+      fit.chi2 += e.dot(w * e);
     }
-    const Eigen::Vector3d delta = information.ldlt().solve(b);
-    if (!delta.allFinite()) {
-      step_seen_.clear();
-      return;
-    }
-    pose += delta;
-    pose.z() = Wrap(pose.z());
-    if (delta.norm() < 1e-9) break;
+    const Eigen::Vector3d eigen =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(fit.information).eigenvalues();
+    const Eigen::Vector3d delta = fit.information.ldlt().solve(b);
+    if (!(eigen(0) > 1e-9 * eigen(2)) || !delta.allFinite()) return std::nullopt;
+    fit.pose += delta;
+    fit.pose.z() = Wrap(fit.pose.z());
+    if (delta.head<2>().norm() < 1e-5 && std::abs(delta.z()) < 1e-5) return fit;
   }
+  return std::nullopt;
+}
+
+void EkfSlam::CheckStep() {
+  const AdaptiveOptions& a = options_.adaptive;
+  const std::vector<Seen> seen_list = std::move(step_seen_);
   step_seen_.clear();
+  const int m = static_cast<int>(seen_list.size());
+  if (m < 2) return;
+  // The pose that best explains this step's measurements alone, against the landmarks as they
+  // were before these measurements updated them (so that the residual is not shrunk by its
+  // own update); each measurement weighted by its noise and its landmark's uncertainty.
+  std::optional<SnapshotFit> fit = FitSnapshot(seen_list, -1);
+  if (!fit) return;
+  int m_used = m;
+  if (m >= 3 && fit->chi2 > Chi2Quantile(1.0 - 1e-6, 2 * m - 3)) {
+    std::optional<SnapshotFit> best;
+    for (int j = 0; j < m; ++j) {
+      if (!seen_list[j].refused) continue;
+      std::optional<SnapshotFit> without = FitSnapshot(seen_list, j);
+      if (without && (!best || without->chi2 < best->chi2)) best = without;
+    }
+    if (best && best->chi2 <= Chi2Quantile(0.975, 2 * (m - 1) - 3)) {
+      fit = best;
+      m_used = m - 1;
+      ++counters_.excluded;
+    }
+  }
+  const Eigen::Vector3d pose = fit->pose;
+  const Eigen::Matrix3d information = fit->information;
+  const double chi2 = fit->chi2;
   step_checks_ = true;
   // The sensor: the fit's residual, 2m - 3 degrees of freedom.
-  const int dof = 2 * m - 3;
+  const int dof = 2 * m_used - 3;
   window_.residual_chi2 += std::min(chi2, 0.5 * a.nis_cap * dof);  // outliers count at most this
   window_.residual_dof += dof;
   // The motion: the step's predicted pose against the fit, 3 degrees of freedom.
@@ -414,18 +433,32 @@ UpdateOutcome EkfSlam::Associate(const RangeBearing& z) {
   if (z.id >= 0) {
     for (int i = 0; i < landmark_count(); ++i) {
       if (ids_[i] != z.id) continue;
-      if (options_.adaptive.enabled) step_seen_.push_back({z, landmark(i), landmark_covariance(i)});
       const double d2 = Mahalanobis2(z, i);
+      // The step's snapshot (CheckStep) takes each landmark once: repeated frames of one marker
+      // at a stop share its bias and add no geometry. The first frame's is the one kept.
+      if (options_.adaptive.enabled &&
+          std::none_of(step_seen_.begin(), step_seen_.end(),
+                       [&](const Seen& seen) { return seen.z.id == z.id; })) {
+        step_seen_.push_back(
+            {z, landmark(i), landmark_covariance(i), d2 > options_.association.new_chi2});
+      }
       if (d2 <= options_.association.new_chi2) {
         ApplyUpdate(z, i);
         if (lost_) ++counters_.reacquired;
         lost_ = false;
         known_failures_ = 0;
+        failing_ids_.clear();
         return UpdateOutcome::kUpdated;
       }
-      // A known landmark outside the gate: evidence that the belief is too narrow.
-      RecordNis(d2);
-      if (!options_.adaptive.enabled || ++known_failures_ < options_.adaptive.lost_after)
+      // A known landmark outside the gate: the belief is too narrow, or the measurement is
+      // wrong (a misdetected marker keeps failing at every frame). It is an outlier to the
+      // noise adaptation (covariance matching takes the innovations it updates with); the
+      // belief is taken for lost only when two or more landmarks fail with none pairing.
+      if (!options_.adaptive.enabled) return UpdateOutcome::kRejected;
+      ++known_failures_;
+      if (std::find(failing_ids_.begin(), failing_ids_.end(), z.id) == failing_ids_.end())
+        failing_ids_.push_back(z.id);
+      if (known_failures_ < options_.adaptive.lost_after || failing_ids_.size() < 2)
         return UpdateOutcome::kRejected;
       // Lost: widen the pose so that this innovation sits inside the gate, and pair again.
       lost_ = true;
@@ -435,6 +468,7 @@ UpdateOutcome EkfSlam::Associate(const RangeBearing& z) {
       ++counters_.reacquired;
       lost_ = false;
       known_failures_ = 0;
+      failing_ids_.clear();
       return UpdateOutcome::kUpdated;
     }
     AddLandmark(z);

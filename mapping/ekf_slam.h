@@ -73,20 +73,28 @@ struct AssociationOptions {
 };
 
 // The filter checking itself against what it observes. The normalised innovation squared
-// (NIS, e^T S^-1 e, 2 dof) of every measurement tried against a landmark is kept over a
-// sliding window. Covariance matching (Mehra 1972; the scaled-Q form of Sage and Husa's
+// (NIS, e^T S^-1 e, 2 dof) of every measurement that updates the filter is kept over a
+// sliding window (a measurement outside the gate is an outlier to it: a misdetected marker
+// fails at every frame). Covariance matching (Mehra 1972; the scaled-Q form of Sage and Husa's
 // adaptive filter): when the window's mean NIS lies above the 97.5 % bound of its chi-square
 // band the process noise is scaled up by `growth`, and scaled back towards 1 by the same
 // factor when the mean falls below its expectation (2). Lost and found: after `lost_after`
-// known-id measurements in a row fail the gate, the pose is widened (its rows and columns of P
-// scaled so that the failing innovation would sit inside the gate) and the measurement tried
-// again; a pairing then ends the lost state (re-acquired).
+// known-id measurements in a row fail the gate, of two or more landmarks (one landmark that
+// keeps failing while nothing else is seen may be a misdetection), the pose is widened (its
+// rows and columns of P scaled so that the failing innovation would sit inside the gate) and
+// the measurement tried again; a pairing then ends the lost state (re-acquired).
 // Which noise is wrong: a large innovation says the prediction and the measurement disagree,
 // not whether the motion or the sensor noise was understated. The measurements of one step
 // tell them apart: a pose error is common to all of them, sensor noise is not. So at the end
 // of each step (the next Predict), when two or more known landmarks were measured, the pose is
 // fitted to those measurements alone, the prior ignored (the snapshot least-squares residual
-// test of GPS integrity monitoring, RAIM: Parkinson and Axelrad 1988). Its residual
+// test of GPS integrity monitoring, RAIM: Parkinson and Axelrad 1988), each landmark once (the
+// step's first measurement of it: repeated frames at a stop share their error), and only when
+// the fit has a unique answer. A misdetected marker would pass for noisy measurements: among
+// three or more, a measurement the gate refused whose leaving out brings the residual inside
+// its 97.5 % band is excluded (RAIM fault detection and exclusion, Brown 1992, limited to what
+// the prediction already doubts; excluding any measurement raised the filter's NEES where the
+// motion noise is 10x the told). Its residual
 // chi-square (2m - 3 degrees of freedom) does not depend on the motion noise; the predicted
 // pose against the fitted one (3 degrees of freedom) tests the motion. Over `sensor_window`
 // such steps, or at once when a bound passed by chance once in a million checks is passed:
@@ -102,7 +110,8 @@ struct AdaptiveOptions {
   int window = 20;         // measurements per NIS window
   double growth = 2.0;     // process-noise scale factor per window outside the band
   double max_scale = 1e3;  // the process noise is never scaled beyond this
-  int lost_after = 3;      // known-id gate failures in a row before the pose is widened
+  int lost_after = 3;      // known-id gate failures in a row, of >= 2 landmarks, before the
+                           // pose is widened
   double nis_cap = 100.0;  // one measurement's NIS counts at most this much in the window
   int sensor_window = 10;  // steps (with >= 2 known landmarks seen) per sensor-noise window
 };
@@ -116,6 +125,7 @@ struct FilterCounters {
   int reacquired = 0;         // updates that ended a lost state after the pose was widened
   int adaptive_episodes = 0;  // times the process noise was raised from its nominal level
   int sensor_episodes = 0;    // times the measurement noise was raised
+  int excluded = 0;           // step checks that left a refused, inconsistent measurement out
   double nis_sum = 0.0;       // NIS of the measurements that updated the filter
   int nis_count = 0;
   double MeanNis() const { return nis_count ? nis_sum / nis_count : 0.0; }
@@ -252,8 +262,19 @@ class EkfSlam {
     RangeBearing z;
     Eigen::Vector2d landmark;
     Eigen::Matrix2d covariance;
+    bool refused = false;  // outside the gate against the prediction
   };
   std::vector<Seen> step_seen_;
+  // The pose that best explains `seen` alone but for `skip` (-1: none), by Gauss-Newton from
+  // the estimate, with its
+  // information and residual chi-square; nullopt when the fit has no unique answer (two landmarks
+  // in line with the robot) or does not settle.
+  struct SnapshotFit {
+    Eigen::Vector3d pose;
+    Eigen::Matrix3d information;
+    double chi2 = 0.0;
+  };
+  std::optional<SnapshotFit> FitSnapshot(const std::vector<Seen>& seen, int skip) const;
   struct Prior {
     Eigen::Vector3d pose;
     Eigen::Matrix3d covariance;
@@ -267,7 +288,8 @@ class EkfSlam {
   bool step_checks_ = false;  // steps with >= 2 known landmarks seen: they decide Q, not NIS
   double r_scale_ = 1.0;
   bool sensor_suspect_ = false;
-  int known_failures_ = 0;  // known-id gate failures in a row
+  int known_failures_ = 0;        // known-id gate failures in a row
+  std::vector<int> failing_ids_;  // the landmarks among them
   bool lost_ = false;
 };
 
