@@ -788,13 +788,23 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               // ball partly hidden behind others shows a smaller piece of the same curve.
               const double apparent_px =
                   focal * best->radius_m / (surface->depth_m + best->surface_to_centre_m);
-              const std::optional<SurfaceBulge> bulge =
-                  MeasureSurfaceBulge(depth_roi, piece_mask, d.centre_px - cv::Point2d(roi.tl()),
-                                      std::max(d.radius_px, apparent_px), *setup.camera);
               // Flat: within the noise of no bulge either way (a piece whose centre reads
-              // deeper than its rims is something else: two objects at different depths).
-              if (bulge && std::abs(bulge->bulge_m) + 3.0 * bulge->sigma_m <
-                               options.min_bulge_ratio * best->radius_m) {
+              // deeper than its rims is something else: two objects at different depths),
+              // across the rows or across the columns (a box's edge curves one way only).
+              const auto flat = [&](bool along_columns) {
+                std::optional<SurfaceBulge> bulge = MeasureSurfaceBulge(
+                    depth_roi, piece_mask, d.centre_px - cv::Point2d(roi.tl()),
+                    std::max(d.radius_px, apparent_px), *setup.camera, along_columns);
+                // A piece narrower than the kind (a bumper cut to its size) has no rims that
+                // far out: its own extent then.
+                if (!bulge)
+                  bulge = MeasureSurfaceBulge(depth_roi, piece_mask,
+                                              d.centre_px - cv::Point2d(roi.tl()), d.radius_px,
+                                              *setup.camera, along_columns);
+                return bulge && std::abs(bulge->bulge_m) + 3.0 * bulge->sigma_m <
+                                    options.min_bulge_ratio * best->radius_m;
+              };
+              if (flat(false) || flat(true)) {
                 ++st.rejected_flat;
                 continue;
               }

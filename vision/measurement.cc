@@ -100,29 +100,33 @@ std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv:
 
 std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
                                                 const cv::Point2d& centre_px, double radius_px,
-                                                const CameraModel& camera) {
+                                                const CameraModel& camera, bool along_columns) {
   constexpr int kMinReadings = 4;
   if (depth_mm.empty() || depth_mm.type() != CV_16UC1 || blob_mask.size() != depth_mm.size() ||
       !(radius_px > 0.0)) {
     return std::nullopt;
   }
-  std::vector<uint16_t> bands[3];  // left rim, centre, right rim
-  const int v0 = std::max(0, static_cast<int>(std::ceil(centre_px.y - 0.35 * radius_px)));
-  const int v1 =
-      std::min(depth_mm.rows - 1, static_cast<int>(std::floor(centre_px.y + 0.35 * radius_px)));
-  const int u0 = std::max(0, static_cast<int>(std::ceil(centre_px.x - 0.85 * radius_px)));
-  const int u1 =
-      std::min(depth_mm.cols - 1, static_cast<int>(std::floor(centre_px.x + 0.85 * radius_px)));
-  for (int v = v0; v <= v1; ++v) {
-    const uint8_t* m = blob_mask.ptr<uint8_t>(v);
-    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
-    for (int u = u0; u <= u1; ++u) {
-      if (!m[u] || !d[u]) continue;
-      const double x = (u - centre_px.x) / radius_px;
+  // `across` runs through the rims (u along rows, v along columns), `along` is the band's
+  // width.
+  const double across_c = along_columns ? centre_px.y : centre_px.x;
+  const double along_c = along_columns ? centre_px.x : centre_px.y;
+  const int across_n = along_columns ? depth_mm.rows : depth_mm.cols;
+  const int along_n = along_columns ? depth_mm.cols : depth_mm.rows;
+  std::vector<uint16_t> bands[3];  // one rim, centre, other rim
+  const int a0 = std::max(0, static_cast<int>(std::ceil(along_c - 0.35 * radius_px)));
+  const int a1 = std::min(along_n - 1, static_cast<int>(std::floor(along_c + 0.35 * radius_px)));
+  const int c0 = std::max(0, static_cast<int>(std::ceil(across_c - 0.85 * radius_px)));
+  const int c1 = std::min(across_n - 1, static_cast<int>(std::floor(across_c + 0.85 * radius_px)));
+  for (int a = a0; a <= a1; ++a) {
+    for (int c = c0; c <= c1; ++c) {
+      const int u = along_columns ? a : c, v = along_columns ? c : a;
+      const uint16_t d = depth_mm.at<uint16_t>(v, u);
+      if (!blob_mask.at<uint8_t>(v, u) || !d) continue;
+      const double x = (c - across_c) / radius_px;
       if (std::abs(x) <= 0.3) {
-        bands[1].push_back(d[u]);
+        bands[1].push_back(d);
       } else if (std::abs(x) >= 0.55) {
-        bands[x < 0.0 ? 0 : 2].push_back(d[u]);
+        bands[x < 0.0 ? 0 : 2].push_back(d);
       }
     }
   }

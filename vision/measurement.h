@@ -63,13 +63,17 @@ Measurement MeasureFromSurface(const BlobSurface& surface, const cv::Point2d& ce
 // plane (a slope adds as much on one side as it takes on the other).
 // Bands, in x the apparent radius: rows within 0.35 of the centre; the centre |u| <= 0.3, the
 // rims 0.55 <= |u| <= 0.85. `centre_px` is in the mask's own pixels (not the full image's).
+// `along_columns`: the same with rows and columns swapped (top and bottom rims). A ball curves
+// away both ways; the edge where two faces of a box meet curves one way only (a vertical edge
+// across the rows, the top face's edge across the columns).
 struct SurfaceBulge {
   double bulge_m = 0.0;  // the rims' mean inverse median depth below the centre's, x depth^2
   double sigma_m = 0.0;  // its standard deviation from the camera's depth noise
 };
 std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const cv::Mat& blob_mask,
                                                 const cv::Point2d& centre_px, double radius_px,
-                                                const CameraModel& camera);
+                                                const CameraModel& camera,
+                                                bool along_columns = false);
 
 // The median of depth readings as std::nth_element gives it (the element of rank size / 2),
 // by a two-pass radix count instead of partial sorting. `readings` must not be empty.

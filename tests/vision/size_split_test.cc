@@ -240,6 +240,11 @@ TEST(SurfaceBulgeTest, ABallCurvesAwayAndAWallDoesNot) {
     ASSERT_TRUE(bulge.has_value());
     EXPECT_NEAR(bulge->bulge_m / radius_m, 0.28, 0.08);
     EXPECT_LT(3.0 * bulge->sigma_m, 0.1 * radius_m);
+    // And from its top to its bottom.
+    const std::optional<SurfaceBulge> down = MeasureSurfaceBulge(
+        frame.depth_mm, mask, centre, std::sqrt(m.m00 / M_PI), camera, /*along_columns=*/true);
+    ASSERT_TRUE(down.has_value());
+    EXPECT_GT(down->bulge_m - 3.0 * down->sigma_m, 0.1 * radius_m);
   }
   // A flat face 1 m ahead, square on and turned 30-70 degrees about the vertical, drawn
   // exactly (raw readings through the camera's depth correction, no noise): no bulge. Compared
@@ -266,6 +271,46 @@ TEST(SurfaceBulgeTest, ABallCurvesAwayAndAWallDoesNot) {
     SCOPED_TRACE("face turned " + std::to_string(turn_deg) + " deg");
     ASSERT_TRUE(bulge.has_value());
     EXPECT_LT(std::abs(bulge->bulge_m) + 3.0 * bulge->sigma_m, 0.1 * radius_m);
+  }
+}
+
+// The edge where two faces of a box meet, turned 45 degrees to the camera either side (an
+// opponent's bumper at its corner), curves away across it and not along it: a vertical edge
+// bulges between the left and right rims only, the same edge turned on its side between the
+// top and bottom rims only. The detector drops a round kind's piece that is flat either way.
+TEST(SurfaceBulgeTest, ABoxEdgeCurvesOneWayOnly) {
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  const CameraModel camera(robot.camera);
+  const double radius_m = 0.08;
+  const int cols = robot.camera.width_px, rows = robot.camera.height_px;
+  const double radius_px = 40.0;
+  const cv::Point2d centre(cols / 2.0, rows / 2.0);
+  cv::Mat mask(rows, cols, CV_8UC1, cv::Scalar(0));
+  cv::circle(mask, centre, static_cast<int>(radius_px), cv::Scalar(255), cv::FILLED);
+  for (bool vertical_edge : {true, false}) {
+    cv::Mat depth(rows, cols, CV_16UC1, cv::Scalar(0));
+    for (int v = 0; v < rows; ++v) {
+      for (int u = 0; u < cols; ++u) {
+        const Eigen::Vector3d ray = camera.BackProject(u, v, 1.0);  // at unit depth
+        const Eigen::Vector3d c = camera.BackProject(centre.x, centre.y, 1.0);
+        // Faces z = 1 + |s| (s across the edge, through the centre's ray): the edge 1 m ahead.
+        const double s_ray = vertical_edge ? ray.x() - c.x() : ray.y() - c.y();
+        const double z_m = 1.0 / (1.0 - std::abs(s_ray));
+        depth.at<uint16_t>(v, u) = static_cast<uint16_t>(std::lround(
+            robot.camera.depth_correction.a * z_m * 1000.0 + robot.camera.depth_correction.b_mm));
+      }
+    }
+    SCOPED_TRACE(vertical_edge ? "vertical edge" : "horizontal edge");
+    const std::optional<SurfaceBulge> across_rows =
+        MeasureSurfaceBulge(depth, mask, centre, radius_px, camera, /*along_columns=*/false);
+    const std::optional<SurfaceBulge> across_columns =
+        MeasureSurfaceBulge(depth, mask, centre, radius_px, camera, /*along_columns=*/true);
+    ASSERT_TRUE(across_rows.has_value());
+    ASSERT_TRUE(across_columns.has_value());
+    const SurfaceBulge& curved = vertical_edge ? *across_rows : *across_columns;
+    const SurfaceBulge& straight = vertical_edge ? *across_columns : *across_rows;
+    EXPECT_GT(curved.bulge_m - 3.0 * curved.sigma_m, 0.1 * radius_m);
+    EXPECT_LT(std::abs(straight.bulge_m) + 3.0 * straight.sigma_m, 0.1 * radius_m);
   }
 }
 
