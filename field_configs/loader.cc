@@ -527,7 +527,7 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   const YamlReader camera = root.Required("camera");
   camera.AllowKeys({"model", "width_px", "height_px", "cx", "cy", "fx", "fy", "min_range_m",
                     "max_range_m", "frame_rate_hz", "colour_depth_baseline_m", "mount", "noise",
-                    "depth_correction"});
+                    "depth_correction", "stop_bias"});
   CameraConfig& c = robot->camera;
   c.model = camera.Required("model").String();
   c.width_px = camera.Required("width_px").IntInRange(16, 8192);
@@ -574,6 +574,11 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   correction.AllowKeys({"a", "b_mm"});
   c.depth_correction.a = correction.Required("a").InRange(0.5, 2.0);
   c.depth_correction.b_mm = correction.Required("b_mm").InRange(-500.0, 500.0);
+
+  const YamlReader stop_bias = camera.Required("stop_bias");
+  stop_bias.AllowKeys({"range_sigma_m", "bearing_sigma_deg"});
+  c.stop_bias_range_sigma_m = stop_bias.Required("range_sigma_m").InRange(0.0, 1.0);
+  c.stop_bias_bearing_sigma_deg = stop_bias.Required("bearing_sigma_deg").InRange(0.0, 10.0);
 
   if (auto imu = root.Optional("imu")) {
     imu->AllowKeys({"model", "noise_deg", "drift_deg_per_sqrt_s"});

@@ -122,6 +122,10 @@ struct CameraConfig {
   CameraMount mount;
   DepthNoise noise;
   DepthCorrection depth_correction;
+  // The error a stop's repeated frames share (one per stop, not averaged away by more frames):
+  // SLAM-O's iterated-frame covariance (mapping::IteratedFrameCovariance) for its markers.
+  double stop_bias_range_sigma_m = 0.0;
+  double stop_bias_bearing_sigma_deg = 0.0;
 };
 
 struct IntakeConfig {

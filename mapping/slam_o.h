@@ -36,7 +36,8 @@ struct SlamOOptions {
   EkfOptions ekf;
   // A per-stop measurement bias (range m^2, bearing rad^2) shared by a stop's frames, so that
   // iterating frames does not shrink the covariance below what the camera's bias allows
-  // (IteratedFrameCovariance).
+  // (IteratedFrameCovariance). The matches take it from the robot file
+  // (CameraConfig::stop_bias_*); this default is the thesis robot's.
   Eigen::Matrix2d stop_bias_covariance = Eigen::Vector2d(0.01 * 0.01, 0.005 * 0.005).asDiagonal();
   // Per-frame (white) covariance of a marker measurement; zero: vision's own estimate for
   // each detection.

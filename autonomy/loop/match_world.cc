@@ -121,6 +121,12 @@ mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::Robot
   options.ekf.motion = mapping::MotionNoiseFor(robot.odometry_noise);
   options.ekf.max_range_m = robot.camera.max_range_m;
   options.ekf.add_landmarks = false;
+  // Its camera's per-stop bias, shared by a stop's frames.
+  const double bias_bearing_rad = robot.camera.stop_bias_bearing_sigma_deg * kPi / 180.0;
+  options.stop_bias_covariance =
+      Eigen::Vector2d(robot.camera.stop_bias_range_sigma_m * robot.camera.stop_bias_range_sigma_m,
+                      bias_bearing_rad * bias_bearing_rad)
+          .asDiagonal();
   options.ekf.adaptive.enabled = adaptive;
   options.relocalise = relocalise;
   return mapping::SlamO(field, robot.camera, prior, options);

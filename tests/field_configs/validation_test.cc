@@ -204,5 +204,15 @@ TEST_F(RobotValidationTest, MisspeltCameraKey) {
   EXPECT_NE(e.expected().find("did you mean 'fy'?"), std::string::npos) << e.what();
 }
 
+TEST_F(RobotValidationTest, StopBiasIsRequiredAndBounded) {
+  const ConfigError negative =
+      Reject(Edit(text_, "    range_sigma_m: 0.01", "    range_sigma_m: -0.01"));
+  EXPECT_EQ(negative.key_path(), "camera.stop_bias.range_sigma_m");
+  const ConfigError missing = Reject(Edit(text_, "  stop_bias:", "  stop_biass:"));
+  EXPECT_EQ(missing.key_path(), "camera.stop_biass");
+  EXPECT_NE(missing.expected().find("did you mean 'stop_bias'?"), std::string::npos)
+      << missing.what();
+}
+
 }  // namespace
 }  // namespace slamo::field
