@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -15,6 +16,7 @@
 #include "autonomy/cli/options.h"
 #include "autonomy/experiments/calibration.h"
 #include "autonomy/experiments/recording_run.h"
+#include "autonomy/experiments/tuning.h"
 #include "autonomy/io/sim_io.h"
 #include "autonomy/loop/executive.h"
 #include "autonomy/reports/match_report.h"
@@ -41,6 +43,7 @@ struct DryRunArgs {
   bool quiet = false;
   bool frames_png = false;
   std::string recording;  // --from-recording: a TUM folder or rawlog instead of the simulator
+  std::vector<std::string> params;  // name=value, as one combination of `slamo tune --param`
 };
 
 // SLAM-O on a recording: report.json, map.png, trajectory.tum (+ groundtruth.tum when the
@@ -87,6 +90,14 @@ int DryRun(const DryRunArgs& args) {
     mapping::ParseFrameRule(args.frames, &setup.frames);
     strategy::MakeStrategy(args.strategy, setup.strategy_options);
     setup.scenario = ParseScenario(args.scenario);
+    for (const std::string& param : args.params) {
+      const size_t eq = param.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == param.size() ||
+          param.find(',') != std::string::npos) {
+        throw std::invalid_argument("--param " + param + ": expected name=value (one value)");
+      }
+      ApplyParam(param.substr(0, eq), param.substr(eq + 1), &setup);
+    }
     if (!args.calibration.empty()) {
       setup.strategy_options.learned_success =
           LearnedSuccess(LoadCalibration(args.calibration, season.season, robot.name));
@@ -158,6 +169,10 @@ void RegisterDryRunCommand(CLI::App& app, CommandAction* action) {
   cmd->add_option("--speed", args->speed_mps, "driving speed (m/s); 0: the robot's match_speed_mps")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 5.0));
+  cmd->add_option("--param", args->params,
+                  "name=value: one of `slamo tune`'s parameters (see `slamo tune --help`), to "
+                  "run one of its combinations as a single match; repeatable, applied after the "
+                  "options above");
   cmd->add_flag("!--no-video", args->video, "skip replay.avi");
   cmd->add_flag("--quiet", args->quiet, "no line per action");
   cmd->add_option("--from-recording", args->recording,
