@@ -22,6 +22,8 @@ using platform::kPi;
 constexpr double kAtStage_m = 0.25;
 // Position errors of the target and its neighbours the pick corridor allows for.
 constexpr double kCorridorSlack_m = 0.05;
+// A staging pose for a tube's end counts as reached only this near the tube's axis.
+constexpr double kTubeAcross_m = 0.05;
 
 double Wrap(double a) {
   const double w = std::remainder(a, 2.0 * kPi);
@@ -156,6 +158,32 @@ class Base : public Strategy {
     return std::lround(p.x() * 20.0) * 100000 + std::lround(p.y() * 20.0);
   }
 
+  // Whether a robot at `pose` starts the pick (of `object`) or the release (into goal
+  // `goal_index`, object nullptr) from where it stands, without driving to `stage` first: the
+  // pick and the release turn to their target and drive the rest. A pick also needs the object
+  // no nearer than where the intake takes it: closer, the turn to it would sweep it with the
+  // robot's corners (after a drop, the robot stands beside it). A tube takes an object only
+  // from a robot driving into one of its ends along the axis (platform::GoalTakes): from
+  // beside its stage the release would come in at an angle and miss, so there the robot must
+  // stand on the axis's line, not past the stage.
+  static bool AtStage(const StrategyContext& c, const Eigen::Vector3d& pose,
+                      const Eigen::Vector3d& stage, const ObjectBelief* object, bool knock,
+                      int goal_index) {
+    if ((pose.head<2>() - stage.head<2>()).norm() >= kAtStage_m) return false;
+    if (object && !knock) {
+      const double r = ObjectRadius(*c.season, object->kind);
+      return (object->position_m - pose.head<2>()).norm() >=
+             PickDistance(*c.robot, r) - kAtStage_m / 10.0;
+    }
+    if (object || goal_index < 0) return true;
+    const field::Goal& goal = c.season->goals[goal_index];
+    if (goal.kind != field::GoalKind::kGoal || goal.entry != field::Goal::Entry::kEnds) return true;
+    const Eigen::Vector2d axis(std::cos(stage.z()), std::sin(stage.z()));
+    const Eigen::Vector2d rel = pose.head<2>() - stage.head<2>();
+    const double across = std::abs(rel.x() * axis.y() - rel.y() * axis.x());
+    return across <= kTubeAcross_m && rel.dot(axis) <= kTubeAcross_m;
+  }
+
   // Seconds for the final straight approach of margin_m and the settling around it.
   double ApproachSeconds(const StrategyContext& c) const {
     return options_.approach_margin_m / c.robot->drive.cruise_speed_mps + 0.5;
@@ -248,7 +276,8 @@ class Base : public Strategy {
   }
 
   // The goals an object scores in, with their best staging pose from `from` and the time to
-  // get there and release.
+  // get there and release. `from_robot`: `from` is where the robot stands, and a stage it
+  // releases from without driving there first (AtStage) costs no drive.
   struct GoalChoice {
     int goal = -1;
     Eigen::Vector3d stage;
@@ -257,7 +286,8 @@ class Base : public Strategy {
   };
   std::vector<GoalChoice> GoalChoices(const Belief& b, const StrategyContext& c,
                                       const std::string& kind, const std::string& colour,
-                                      const Eigen::Vector3d& from, int except) const {
+                                      const Eigen::Vector3d& from, int except,
+                                      bool from_robot = false) const {
     std::vector<GoalChoice> out;
     const double r = ObjectRadius(*c.season, kind);
     for (int g = 0; g < static_cast<int>(c.season->goals.size()); ++g) {
@@ -276,7 +306,9 @@ class Base : public Strategy {
                           &c.season->goals[g])) {
           continue;
         }
-        const std::optional<double> t = c.travel_time_s(from, stage);
+        const std::optional<double> t = from_robot && AtStage(c, from, stage, nullptr, false, g)
+                                            ? 0.0
+                                            : c.travel_time_s(from, stage);
         if (!t) continue;
         const double seconds =
             *t * Scale(kDrive) + (ApproachSeconds(c) + options_.release_s) * Scale(kReleaseClass);
@@ -456,7 +488,7 @@ class Base : public Strategy {
 
   std::vector<Cycle> HeldCycles(const Belief& b, const StrategyContext& c, int frames) const {
     std::vector<Cycle> out;
-    for (const GoalChoice& g : GoalChoices(b, c, b.held->kind, b.held->colour, b.pose, -1)) {
+    for (const GoalChoice& g : GoalChoices(b, c, b.held->kind, b.held->colour, b.pose, -1, true)) {
       Cycle cycle;
       cycle.goal = g.goal;
       cycle.score_stage = g.stage;
@@ -483,15 +515,7 @@ class Base : public Strategy {
       return a;
     }
     const Eigen::Vector3d stage = cycle.object ? cycle.pick_stage : cycle.score_stage;
-    // Near enough: the pick and the release turn to their target and drive the rest. A pick
-    // also needs the object no nearer than where the intake takes it: closer, the turn to it
-    // would sweep it with the robot's corners (after a drop, the robot stands beside it).
-    bool at_stage = (b.pose.head<2>() - stage.head<2>()).norm() < kAtStage_m;
-    if (cycle.object && !cycle.knock) {
-      const double r = ObjectRadius(*c.season, cycle.object->kind);
-      at_stage = at_stage && (cycle.object->position_m - b.pose.head<2>()).norm() >=
-                                 PickDistance(*c.robot, r) - kAtStage_m / 10.0;
-    }
+    const bool at_stage = AtStage(c, b.pose, stage, cycle.object, cycle.knock, cycle.goal);
     if (cycle.knock) {
       a.kind = ActionKind::kNavigate;
       a.object_id = cycle.object->id;

@@ -1,5 +1,8 @@
 #include "strategy/strategy.h"
 
+#include <algorithm>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "field_configs/loader.h"
@@ -365,6 +368,60 @@ TEST_F(StrategyTest, SlowDrivesMakeThePlannerStartOnlyWhatStillFits) {
     only_raw += raw && !learned;
   }
   EXPECT_GT(only_raw, 2);
+}
+
+// A Push Back long goal is a tube entered along its axis: a robot holding a block beside the
+// tube's staging pose (within the distance that counts as reached, but off the axis) drives
+// to the stage first; released from there, its straight run came in at 37 degrees and missed
+// (seed 5 with the V5 robot). On the axis behind the stage, it releases at once.
+TEST_F(StrategyTest, ATubeIsReleasedIntoOnlyFromItsAxis) {
+  season_ = field::LoadSeasonConfig("push_back");
+  robot_ = field::LoadRobotConfig("v5_drivetrain");
+  // The long goal the only goal, so that the choice is between releasing and driving first.
+  const auto long_goal =
+      std::find_if(season_.goals.begin(), season_.goals.end(),
+                   [](const field::Goal& g) { return g.name == "long_goal_left"; });
+  ASSERT_NE(long_goal, season_.goals.end());
+  season_.goals = {*long_goal};
+  map_ = std::make_unique<mapping::ObjectMap>(season_);
+  planner_ = std::make_unique<planning::Planner>(robot_);
+  planner_->SetMap(*map_);
+  travel_ = std::make_unique<TravelField>(robot_.drive);
+  travel_->SetPlanner(*planner_);
+  const int tube = Goal("long_goal_left");
+  ASSERT_GE(tube, 0);
+  ASSERT_EQ(season_.goals[tube].entry, field::Goal::Entry::kEnds);
+  const auto first = [&](const Eigen::Vector3d& pose) {
+    StrategyOptions options;
+    options.frame_choices = {0};
+    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
+    Belief b;
+    b.deadline_s = 15.0;
+    b.pose = pose;
+    b.held =
+        ObjectBelief{-1, "block", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
+    planner->Next(b, context_);  // the survey
+    b.now_s = 0.3;
+    return planner->Next(b, context_);
+  };
+  const std::vector<Eigen::Vector3d> stages =
+      ScoreStages(context_, tube, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
+  ASSERT_FALSE(stages.empty());
+  // The mouth at the red alliance's end (-x), entered facing +x.
+  const Eigen::Vector3d stage = *std::min_element(
+      stages.begin(), stages.end(),
+      [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.x() < b.x(); });
+  ASSERT_NEAR(stage.z(), 0.0, 1e-6);
+  // Beside it: 0.22 m off, 0.2 m off the axis, facing away (where seed 5 stood after a pick).
+  const Action beside =
+      first(Eigen::Vector3d(stage.x() + 0.13, stage.y() - 0.18, -55.0 * M_PI / 180.0));
+  ASSERT_EQ(beside.goal_index, tube) << beside.why;
+  EXPECT_EQ(beside.kind, ActionKind::kNavigate) << beside.why;
+  EXPECT_NEAR(beside.target.y(), stage.y(), 1e-9);
+  // On the axis, 5 cm behind the stage.
+  const Action behind = first(Eigen::Vector3d(stage.x() - 0.05, stage.y(), 0.0));
+  ASSERT_EQ(behind.goal_index, tube) << behind.why;
+  EXPECT_EQ(behind.kind, ActionKind::kScore) << behind.why;
 }
 
 // The scripted route from the red hanging-zone tile, planned on the nominal layout: it
