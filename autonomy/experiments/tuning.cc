@@ -70,6 +70,8 @@ const std::map<std::string, std::string>& TunableParams() {
       {"check_spacing", "m of path between quick looks while driving (0: none)"},
       {"correction_frames", "frames of a quick look"},
       {"arrival_fixes", "look-and-correct rounds on arrival"},
+      {"reverse_max",
+       "path legs behind the robot up to this long (m) are driven backwards (0: never)"},
       {"pushable", "objects narrower than this fraction of the robot are pushed, not avoided"},
       {"arrival_frames", "planner: frames to check an arrival"},
       {"observe_first", "planner: 1 weighs observing before a cycle (frames 5, 10, 20); 0 never"},
@@ -112,6 +114,8 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->correction_frames = ToInt(name, value);
   } else if (name == "arrival_fixes") {
     setup->arrival_fixes = ToInt(name, value);
+  } else if (name == "reverse_max") {
+    setup->reverse_max_m = ToDouble(name, value);
   } else if (name == "pushable") {
     setup->pushable_fraction = ToDouble(name, value);
   } else if (name == "arrival_frames") {

@@ -474,7 +474,17 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
       Eigen::Vector3d est = slam_.pose();
       Eigen::Vector2d d = waypoints[i] - est.head<2>();
       if (d.norm() < 0.02) continue;
-      const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+      // A short leg behind the robot is driven backwards: two half-turns saved (the camera
+      // then looks where the robot comes from, so only for legs up to reverse_max_m).
+      const bool reverse = [&]() {
+        const double facing = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+        return std::abs(facing) > kPi / 2.0 && d.norm() <= setup_.reverse_max_m;
+      }();
+      const double sign = reverse ? -1.0 : 1.0;
+      const auto leg_turn = [&](const Eigen::Vector2d& leg, const Eigen::Vector3d& from) {
+        return platform::WrapAngleRad(std::atan2(sign * leg.y(), sign * leg.x()) - from.z());
+      };
+      const double turn = leg_turn(d, est);
       // The thesis's stops come at every stop point; the quick looks once per
       // setup_.check_spacing_m.
       const bool stop_here = stop_spacing_m > 0.0 || unseen_m + 1e-6 >= setup_.check_spacing_m;
@@ -493,13 +503,13 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
         }
         est = slam_.pose();
         d = waypoints[i] - est.head<2>();
-        const double again = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
+        const double again = leg_turn(d, est);
         std::vector<DriveStep> steps;
         if (std::abs(again) > 2.0 * kPi / 180.0) steps.push_back(Turn(again * 180.0 / kPi));
-        steps.push_back(Forward(d.norm() / odometry_scale_));
+        steps.push_back(Forward(sign * d.norm() / odometry_scale_));
         Drive(steps);
       } else {
-        Drive({Turn(turn * 180.0 / kPi), Forward(d.norm() / odometry_scale_)});
+        Drive({Turn(turn * 180.0 / kPi), Forward(sign * d.norm() / odometry_scale_)});
       }
     }
     if (replan) continue;

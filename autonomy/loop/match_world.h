@@ -65,6 +65,9 @@ struct MatchSetup {
   int arrival_fixes = 2;
   double arrival_tolerance_m = 0.04;
   double pushable_fraction = 1.0;
+  // Path legs behind the robot up to this long are driven backwards instead of turning round
+  // twice (0: always forwards).
+  double reverse_max_m = 0.6;
   bool gyro =
       true;  // the turn of every motion from a yaw gyro, not the encoders (VEX robots carry one)
   bool adaptive_filter = false;  // the EKF's adaptive noise (mapping::AdaptiveOptions)

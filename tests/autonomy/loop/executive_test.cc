@@ -396,6 +396,42 @@ TEST(Executive, TheV5RobotScoresInOverUnderAndPushBack) {
   }
 }
 
+// Push Back seed 5 with the V5 robot, the planner without looks before cycles or arrival
+// fixes: after its preload it picks a block beside the long goal and goes back to the
+// goal's end. Before, it released from beside the tube's stage at an angle and missed; it now
+// scores both. The way back is a short leg behind the robot: driven backwards it is shorter
+// on the match clock than turning round twice.
+TEST(Executive, TheV5RobotReentersALongGoalAlongItsAxisAndBacksUpShortLegs) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  const auto run = [&](double reverse_max_m) {
+    MatchSetup setup;
+    setup.strategy = "planner";
+    setup.strategy_options.frame_choices = {0};
+    setup.arrival_fixes = 0;
+    setup.reverse_max_m = reverse_max_m;
+    return RunMatch(season, robot, setup, 5);
+  };
+  const MatchResult backwards = run(0.6), forwards = run(0.0);
+  int scored = 0;
+  for (const AttemptCheck& a : backwards.attempts)
+    scored += a.action == "SCORE" && a.outcome == "scored";
+  EXPECT_EQ(scored, 2);
+  EXPECT_EQ(backwards.overrun_s, 0.0);
+  // The drive back to the goal after the pick, in both runs.
+  const auto drive_back = [](const MatchResult& r) {
+    bool picked = false;
+    for (const TimelineEntry& t : r.timeline) {
+      if (t.action == "PICK") picked = true;
+      if (picked && t.action == "NAVIGATE") return t.end_s - t.t_s;
+    }
+    return -1.0;
+  };
+  ASSERT_GT(drive_back(backwards), 0.0);
+  ASSERT_GT(drive_back(forwards), 0.0);
+  EXPECT_LT(drive_back(backwards), drive_back(forwards) - 0.5);
+}
+
 // High Stakes with the V5 robot: the scripted route releases the preload and a picked ring
 // onto a mobile goal's stake (the stakes stand on their bases and move with them; before, the
 // robot pushed the base away from a stake that stayed put, and released onto the floor).
