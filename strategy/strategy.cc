@@ -57,6 +57,10 @@ struct Cycle {
   // held before or after.
   bool knock = false;
   Eigen::Vector3d push_end = Eigen::Vector3d::Zero();
+  // A knock of an object on the floor pushed along it into a zone (FloorPushCycles), and the
+  // seconds of its push and back-off.
+  bool along_floor = false;
+  double push_s = 0.0;
   double Value() const { return probability * gain; }
 };
 
@@ -342,6 +346,16 @@ class Base : public Strategy {
     return nullptr;
   }
 
+  // A push (a knock, or along the floor) carries the object when the bumper meets it within
+  // half its width of its centre.
+  double PushProbability(const Belief& b, const StrategyContext& c, const ObjectBelief& o,
+                         int frames) const {
+    const double pose_var = PoseVarianceAfter(b, frames);
+    const Eigen::Matrix2d cov =
+        o.covariance + Eigen::Matrix2d::Identity() * (pose_var + b.pose_covariance(2, 2) * 0.25);
+    return SuccessProbability(cov, c.robot->width_m / 2.0) * o.confidence;
+  }
+
   // Knocking an object off the raised structure it lies on: for each way across the structure
   // (a box's thin axis), the robot drives straight at it until its bumper is kKnockGap_m short
   // of the structure (or of anything else fixed); its bumper has pushed the object on by its
@@ -365,11 +379,7 @@ class Base : public Strategy {
       cycle.goal = way.goal;
       cycle.seconds = (*t + PushSeconds(c)) * Scale(kDrive) + frames / c.frame_rate_hz;
       cycle.gain = way.points;  // on top of a structure it lies in no zone
-      // Straight off when the bumper meets it within half its width of its centre.
-      const double pose_var = PoseVarianceAfter(b, frames);
-      const Eigen::Matrix2d cov =
-          o.covariance + Eigen::Matrix2d::Identity() * (pose_var + b.pose_covariance(2, 2) * 0.25);
-      cycle.probability = SuccessProbability(cov, c.robot->width_m / 2.0) * o.confidence;
+      cycle.probability = PushProbability(b, c, o, frames);
       cycle.frames = frames;
       out.push_back(cycle);
     }
@@ -436,6 +446,115 @@ class Base : public Strategy {
     return knock_ways_.emplace(key, std::move(ways)).first->second;
   }
 
+  // Pushing object o along the floor into a zone that pays more for it: for each such box
+  // zone, the robot lines up behind o on the line to the nearest point kPushInside_m inside
+  // the zone (beyond the object's radius), drives straight until the object's centre is there
+  // (or until something fixed stops the robot, if the object is then still inside), and backs
+  // out kFloorPushBackOff_m (the knock's push navigation). The bumper carries a ball met within
+  // half the robot's width of its centre (the simulator's push, SimField), so the success model
+  // is the knock's. Not offered when something fixed stops the object on the way, or a known
+  // object of the other alliance's lies in the robot's way (it would be pushed in too).
+  std::vector<Cycle> FloorPushCycles(const Belief& b, const StrategyContext& c,
+                                     const ObjectBelief& o, const Eigen::Vector3d& from,
+                                     int frames) const {
+    constexpr double kPushInside_m = 0.05;
+    std::vector<Cycle> out;
+    if (knocked_.count(o.id)) return out;  // a push is not repeated
+    const field::ObjectType* type = c.season->FindObjectType(o.kind);
+    if (!type) return out;
+    const double r = type->size_m / 2.0;
+    const double before = FloorPoints(*c.season, o.position_m, o.kind, o.colour, c.alliance);
+    const double half = c.season->HalfSize();
+    const double reach = c.robot->length_m / 2.0 + r;  // robot centre to object centre, touching
+    for (int g = 0; g < static_cast<int>(c.season->goals.size()); ++g) {
+      const field::Goal& zone = c.season->goals[g];
+      if (zone.kind != field::GoalKind::kZone || zone.shape != field::SolidShape::kBox) continue;
+      const int points = GoalPoints(*c.season, g, o.kind, o.colour, c.alliance);
+      if (points <= before) continue;
+      // The nearest point of the zone shrunk by the object's radius and kPushInside_m.
+      const double yaw = zone.yaw_deg * kPi / 180.0;
+      const Eigen::Vector2d centre(zone.center_m.x, zone.center_m.y);
+      const Eigen::Vector2d ax(std::cos(yaw), std::sin(yaw)), ay(-std::sin(yaw), std::cos(yaw));
+      const Eigen::Vector2d rel = o.position_m - centre;
+      const double hx = zone.size_m.x / 2.0 - r - kPushInside_m;
+      const double hy = zone.size_m.y / 2.0 - r - kPushInside_m;
+      if (hx <= 0.0 || hy <= 0.0) continue;
+      const Eigen::Vector2d land =
+          centre + std::clamp(rel.dot(ax), -hx, hx) * ax + std::clamp(rel.dot(ay), -hy, hy) * ay;
+      const double length = (land - o.position_m).norm();
+      if (length < 0.01 || length > options_.max_floor_push_m) continue;
+      if (std::abs(land.x()) > half - r || std::abs(land.y()) > half - r) continue;
+      const Eigen::Vector2d dir = (land - o.position_m) / length;
+      const double heading = std::atan2(dir.y(), dir.x());
+      const Eigen::Vector2d contact = o.position_m - reach * dir;
+      const Eigen::Vector2d stage = contact - options_.push_run_in_m * dir;
+      if (!c.is_clear(stage)) continue;
+      // The robot drives from the stage on while its footprint meets nothing fixed, up to
+      // where the object would reach the landing point; something it does not pass under (the
+      // Toss Up barrier, for a robot taller than its clearance) ends the push short, and the
+      // object, pushed kPushGap_m ahead of the bumper, must then still lie in the zone.
+      constexpr double kPushGap_m = 0.01, kStep_m = 0.01, kLandMargin_m = 0.02;
+      const double wanted = (land - reach * dir - stage).norm();
+      double run = -1.0;
+      for (double d = 0.0; d <= wanted + 1e-9; d += kStep_m) {
+        const Eigen::Vector2d p = stage + d * dir;
+        if (!platform::FootprintIsFree(*c.season, platform::Pose2D{p.x(), p.y(), heading},
+                                       c.robot->length_m, c.robot->width_m, c.robot->height_m)) {
+          break;
+        }
+        run = d;
+      }
+      const double pushed_m = run - options_.push_run_in_m;  // how far the object goes
+      if (pushed_m <= 0.0) continue;
+      const Eigen::Vector2d end = stage + run * dir;
+      const Eigen::Vector2d lands = o.position_m + (pushed_m + kPushGap_m) * dir;
+      if (!platform::GoalContains(zone, lands - kLandMargin_m * dir)) continue;
+      // The object's own way: nothing fixed stops it (a large ball does not pass under the
+      // barrier).
+      bool free = true;
+      for (double d = 0.0; free && d <= pushed_m + 1e-9; d += 0.02) {
+        free = !platform::PointBlocksObject(*c.season, o.position_m + d * dir, r, type->height_m);
+      }
+      if (!free) continue;
+      const Eigen::Vector3d stage_pose(stage.x(), stage.y(), heading);
+      if (failed_targets_.count(Key(stage_pose))) continue;
+      // Known objects the bumper would meet on the way are pushed along too: ours may be (they
+      // earn more beyond as well); the other alliance's must not be (it would score them).
+      bool clear = true;
+      for (const ObjectBelief& other : b.objects) {
+        if (other.id == o.id || field::ScoresFor(*c.season, other.colour, c.alliance)) continue;
+        const double ro = ObjectRadius(*c.season, other.kind);
+        const Eigen::Vector2d rel_o = other.position_m - stage;
+        const double along = rel_o.dot(dir);
+        const double side = std::abs(rel_o.x() * dir.y() - rel_o.y() * dir.x());
+        if (along > -ro && along < run + c.robot->length_m / 2.0 + ro &&
+            side < c.robot->width_m / 2.0 + ro) {
+          clear = false;
+          break;
+        }
+      }
+      if (!clear) continue;
+      const std::optional<double> t = c.travel_time_s(from, stage_pose);
+      if (!t) continue;
+      Cycle cycle;
+      cycle.object = &o;
+      cycle.knock = true;
+      cycle.along_floor = true;
+      cycle.pick_stage = stage_pose;
+      cycle.push_end = Eigen::Vector3d(end.x(), end.y(), heading);
+      const Eigen::Vector2d after = end - kFloorPushBackOff_m * dir;  // where the next begins
+      cycle.score_stage = Eigen::Vector3d(after.x(), after.y(), heading);
+      cycle.goal = g;
+      cycle.push_s = (run + kFloorPushBackOff_m) / c.robot->drive.cruise_speed_mps + 1.0;
+      cycle.seconds = (*t + cycle.push_s) * Scale(kDrive) + frames / c.frame_rate_hz;
+      cycle.gain = points - before;
+      cycle.probability = PushProbability(b, c, o, frames);
+      cycle.frames = frames;
+      out.push_back(cycle);
+    }
+    return out;
+  }
+
   // The run-in, and back out the same way (pressed against the structure the robot could not
   // turn, and the way it came is clear).
   double PushSeconds(const StrategyContext& c) const {
@@ -450,6 +569,7 @@ class Base : public Strategy {
     if (!Scores(c, o)) return out;
     if (const field::Structure* raised = RaisedOn(*c.season, o.kind, o.position_m))
       return KnockCycles(b, c, o, *raised, from, frames);
+    if (options_.floor_pushes) out = FloorPushCycles(b, c, o, from, frames);
     const double r = ObjectRadius(*c.season, o.kind);
     // The intake takes the object whose near edge is nearest the bumper across the robot's
     // width: approach from a side where nothing else lies between the stage and the target,
@@ -523,17 +643,19 @@ class Base : public Strategy {
       a.object_colour = cycle.object->colour;
       a.object_m = cycle.object->position_m;
       a.goal_index = cycle.goal;
+      a.along_floor = cycle.along_floor;
       const std::string what =
           cycle.object->colour + " " + cycle.object->kind + " #" + std::to_string(cycle.object->id);
       if (!at_stage) {
         a.target = stage;
         a.expected_s = c.travel_time_s(b.pose, stage).value_or(0.0);
-        a.why = "to knock " + what + " off";
+        a.why = cycle.along_floor ? "to push " + what : "to knock " + what + " off";
       } else {
         a.push = true;
         a.target = cycle.push_end;
-        a.expected_s = PushSeconds(c);
-        a.why = "knock " + what + " into " + c.season->goals[cycle.goal].name;
+        a.expected_s = cycle.along_floor ? cycle.push_s : PushSeconds(c);
+        a.why = (cycle.along_floor ? "push " : "knock ") + what + " into " +
+                c.season->goals[cycle.goal].name;
       }
       return a;
     }
@@ -972,14 +1094,18 @@ class ScriptedStrategy : public Base {
       nav.object_kind = o.kind;
       nav.object_colour = o.colour;
       nav.object_m = o.position_m;
-      nav.why = "script: to knock nominal " + o.colour + " " + o.kind + " off";
+      nav.why = cycle.along_floor ? "script: to push nominal " + o.colour + " " + o.kind
+                                  : "script: to knock nominal " + o.colour + " " + o.kind + " off";
       route_.push_back(nav);
       Action push = nav;
       push.push = true;
+      push.along_floor = cycle.along_floor;
       push.target = cycle.push_end;
       push.goal_index = cycle.goal;
-      push.expected_s = PushSeconds(c);
-      push.why = "script: knock it into " + c.season->goals[cycle.goal].name;
+      push.expected_s = cycle.along_floor ? cycle.push_s : PushSeconds(c);
+      push.why =
+          std::string(cycle.along_floor ? "script: push it into " : "script: knock it into ") +
+          c.season->goals[cycle.goal].name;
       route_.push_back(push);
       return;
     }

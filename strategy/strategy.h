@@ -24,7 +24,8 @@
 // An object lying on top of a raised structure (a large ball on the Toss Up barrier, which it
 // does not fit under) cannot be picked: every strategy may instead knock it off, driving
 // straight into it across the structure so that it drops into the zone beyond (a "push"
-// navigation), valued like a cycle by the points of the zone it lands in.
+// navigation), valued like a cycle by the points of the zone it lands in. An object on the
+// floor may be pushed the same way into a zone that pays more for it (floor_pushes).
 //
 // Baselines: "greedy" (nearest known object of ours, the best goal for it, no search), "thesis"
 // (greedy targets, driven with a stop every 0.3 m and 20 frames at each, as the thesis did),
@@ -84,6 +85,9 @@ struct Action {
   int object_id = -1;  // kPick; kNavigate with push: the object knocked
   // kNavigate with push: where the object is believed to lie (for the record only).
   Eigen::Vector2d object_m = Eigen::Vector2d::Zero();
+  // kNavigate with push: the object lies on the floor and is pushed along it into a zone that
+  // pays more (not knocked off a raised structure).
+  bool along_floor = false;
   // kPick: the target's kind and colour (also where object_id names no tracked object: the
   // scripted route's nominal objects). For the record only: the executive takes what the
   // intake reports.
@@ -121,6 +125,10 @@ struct StrategyOptions {
   // balls) are believed at their spot, with this position sigma, until knocked off (see
   // strategy.cc, RaisedPriors). Not measured: the field facts give no placement tolerance.
   bool raised_priors = true;
+  // Objects on the floor may be pushed along it, up to max_floor_push_m, into a zone where
+  // they earn more (a push navigation, like a knock): a cycle with no pick or release.
+  bool floor_pushes = true;
+  double max_floor_push_m = 1.0;
   // Time cycles with the drive, pick and release estimates scaled by how long those actions
   // took so far in the match (strategy.cc, Base::Scale).
   bool learn_durations = true;
@@ -157,6 +165,9 @@ class Strategy {
   // What came of an action the strategy chose: a target that failed twice is dropped.
   virtual void Feedback(const Action& action, bool succeeded) = 0;
 };
+
+// After pushing an object along the floor the robot backs out this far, clear of it.
+inline constexpr double kFloorPushBackOff_m = 0.15;
 
 // planner, greedy, thesis, scripted.
 const std::vector<std::string>& StrategyNames();

@@ -70,6 +70,7 @@ const std::map<std::string, std::string>& TunableParams() {
       {"check_spacing", "m of path between quick looks while driving (0: none)"},
       {"correction_frames", "frames of a quick look"},
       {"arrival_fixes", "look-and-correct rounds on arrival"},
+      {"floor_push", "1: objects on the floor may be pushed into a zone that pays more; 0: never"},
       {"reverse_max",
        "path legs behind the robot up to this long (m) are driven backwards (0: never)"},
       {"pushable", "objects narrower than this fraction of the robot are pushed, not avoided"},
@@ -114,6 +115,10 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->correction_frames = ToInt(name, value);
   } else if (name == "arrival_fixes") {
     setup->arrival_fixes = ToInt(name, value);
+  } else if (name == "floor_push") {
+    if (value != "0" && value != "1")
+      throw std::invalid_argument("--param floor_push: expected 0 or 1, got \"" + value + "\"");
+    setup->strategy_options.floor_pushes = value == "1";
   } else if (name == "reverse_max") {
     setup->reverse_max_m = ToDouble(name, value);
   } else if (name == "pushable") {
@@ -361,7 +366,7 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
         } else if (a.action == "SCORE") {
           ++s.releases;
           scored += a.outcome == "scored";
-        } else if (a.action == "KNOCK") {
+        } else if (a.action == "KNOCK" || a.action == "PUSH") {
           ++s.knocks;
           knocked += a.outcome == "scored";
         }

@@ -47,13 +47,13 @@ std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const strategy
 
   Eigen::Vector2d aim = action.target.head<2>();
   if (action.kind == ActionKind::kNavigate && action.push) {
-    c.action = "KNOCK";
+    c.action = action.along_floor ? "PUSH" : "KNOCK";
     c.kind = action.object_kind, c.colour = action.object_colour;
     c.goal_index = action.goal_index;
     aim = action.object_m;
     double best = kTargetMatch_m;
     for (const TrueObject& t : *objects) {
-      if (t.held || t.in_goal >= 0 || !Raised(t)) continue;
+      if (t.held || t.in_goal >= 0 || Raised(t) != !action.along_floor) continue;
       if (!c.kind.empty() && (t.kind != c.kind || t.colour != c.colour)) continue;
       const double e = (t.center_m.head<2>() - aim).norm();
       if (e < best) best = e, c.target_truth_id = t.id, c.target_error_m = e;
@@ -90,7 +90,7 @@ std::optional<AttemptCheck> CheckAttempt(const MatchWorld& world, const strategy
 // What came of the attempt, from the simulator's objects before and after it.
 void JudgeAttempt(const field::SeasonConfig& season, const std::vector<TrueObject>& before,
                   const std::vector<TrueObject>& after, AttemptCheck* c) {
-  if (c->action == "KNOCK") {
+  if (c->action == "KNOCK" || c->action == "PUSH") {
     c->outcome = "nothing";
     for (const TrueObject& a : after) {
       if (a.id != c->target_truth_id || Raised(a)) continue;
@@ -274,7 +274,8 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
       case ActionKind::kNavigate:
         // A drive that takes twice its estimate (and 3 s) is stuck or lost: give it up. (The
         // thesis's stops are not in the estimate: no limit for them.)
-        ok = action.push ? world.Push(action.target)
+        ok = action.push ? world.Push(action.target,
+                                      action.along_floor ? strategy::kFloorPushBackOff_m : -1.0)
                          : world.Navigate(
                                action.target, action.stop_spacing_m, action.frames,
                                action.stop_spacing_m > 0.0 ? 0.0 : 2.0 * action.expected_s + 3.0);

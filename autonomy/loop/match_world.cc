@@ -532,13 +532,14 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
   return false;
 }
 
-bool MatchWorld::Push(const Eigen::Vector3d& target) {
+bool MatchWorld::Push(const Eigen::Vector3d& target, double back_m) {
   const Eigen::Vector3d est = slam_.pose();
   const Eigen::Vector2d d = target.head<2>() - est.head<2>();
   const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - est.z());
   Drive({Turn(turn * 180.0 / kPi), Forward(d.norm() / odometry_scale_)});
   const bool reached = (slam_.pose().head<2>() - target.head<2>()).norm() < 0.12;
-  if (now_s() < deadline_s_) Drive({Forward(-d.norm() / odometry_scale_)});
+  const double back = back_m >= 0.0 ? back_m : d.norm();
+  if (now_s() < deadline_s_ && back > 0.0) Drive({Forward(-back / odometry_scale_)});
   return reached;
 }
 

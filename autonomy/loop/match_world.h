@@ -164,8 +164,9 @@ class MatchWorld {
   // A knock: straight from where the robot stands to target.xy, whatever the map holds (the
   // object to knock off lies on the way, and the planner would go round it), and straight back
   // as far (pressed against the structure the robot could not turn; the way it came is clear);
-  // true when the robot got within 0.12 m of target.xy.
-  bool Push(const Eigen::Vector3d& target);
+  // true when the robot got within 0.12 m of target.xy. back_m >= 0: back out only that far
+  // (an object pushed along the floor leaves the robot free to turn).
+  bool Push(const Eigen::Vector3d& target, double back_m = -1.0);
   // Final approach to an object believed at target.xy and the intake; true when the intake
   // took an object of the target's kind and colour (another one is held, but the pick
   // failed).

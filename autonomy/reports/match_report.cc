@@ -484,7 +484,7 @@ void PrintSummary(const MatchResult& r, std::ostream& out) {
     for (const AttemptCheck& a : r.attempts) {
       if (a.action == "PICK") ++picks[a.outcome], ++n_picks;
       if (a.action == "SCORE") ++scores[a.outcome], ++n_scores;
-      if (a.action == "KNOCK") ++knocks[a.outcome], ++n_knocks;
+      if (a.action == "KNOCK" || a.action == "PUSH") ++knocks[a.outcome], ++n_knocks;
     }
     out << "  picks           " << n_picks;
     for (const std::string& k : PickOutcomes()) out << ", " << k << " " << picks[k];

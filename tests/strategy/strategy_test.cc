@@ -216,6 +216,82 @@ TEST_F(StrategyTest, ABallOnTheBarrierIsKnockedIntoTheGoalZoneNotPicked) {
   }
 }
 
+// A red buckyball on the floor 5 cm short of the Toss Up barrier scores 1 in the middle zone
+// and 2 in the goal zone beyond. With too little time left to pick it and reach the stash, the
+// planner pushes it: it lines up behind the ball facing the goal zone, and drives on until the
+// bumper is stopped by the barrier (the thesis robot is taller than the barrier's clearance),
+// which leaves the ball under the barrier with its centre in the goal zone. A blue ball in the
+// way rules the push out (it would be pushed in too); floor_pushes false never pushes.
+TEST_F(StrategyTest, ABallOnTheFloorIsPushedIntoTheZoneThatPaysMore) {
+  // At the thesis robot's match speed (autonomy's MatchRobot), turning at that wheel speed.
+  robot_.drive.cruise_speed_mps = robot_.drive.match_speed_mps;
+  robot_.drive.turn_rate_dps =
+      robot_.drive.cruise_speed_mps / (robot_.drive.track_width_m / 2.0) * 180.0 / M_PI;
+  travel_ = std::make_unique<TravelField>(robot_.drive);
+  travel_->SetPlanner(*planner_);
+  const Eigen::Vector2d ball(0.56, -0.14);
+  const auto decide = [&](bool pushes, bool blue_in_the_way) {
+    StrategyOptions options;
+    options.raised_priors = false;
+    options.floor_pushes = pushes;
+    options.frame_choices = {0};
+    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
+    Belief b;
+    b.pose = Eigen::Vector3d(-0.2, -0.6, 0.0);
+    b.objects.push_back(
+        ObjectBelief{7, "buckyball", "red", ball, Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    if (blue_in_the_way) {
+      b.objects.push_back(ObjectBelief{8, "buckyball", "blue", Eigen::Vector2d(0.40, -0.10),
+                                       Eigen::Matrix2d::Identity() * 1e-4, 1.0});
+    }
+    planner->Next(b, context_);  // the survey
+    b.now_s = b.deadline_s - 12.0;
+    return std::make_pair(planner->Next(b, context_), b);
+  };
+  const auto [a, b] = decide(true, false);
+  ASSERT_EQ(a.kind, ActionKind::kNavigate) << a.why;
+  EXPECT_EQ(a.object_id, 7) << a.why;
+  EXPECT_TRUE(a.along_floor) << a.why;
+  EXPECT_FALSE(a.push) << a.why;  // first to the stage behind the ball
+  EXPECT_NEAR(a.target.z(), 0.0, 1e-6);
+  EXPECT_NEAR(a.target.y(), ball.y(), 1e-6);
+  EXPECT_LT(a.target.x(), ball.x() - robot_.length_m / 2.0);
+  EXPECT_EQ(a.goal_index, Goal("goal_zone"));
+  // At the stage: the push itself, ending where the footprint meets the barrier, the ball
+  // (carried a gap ahead of the bumper) inside the goal zone.
+  std::unique_ptr<Strategy> planner = MakeStrategy("planner", [] {
+    StrategyOptions o;
+    o.raised_priors = false;
+    o.frame_choices = {0};
+    return o;
+  }());
+  Belief at = b;
+  at.now_s = 0.0;
+  planner->Next(at, context_);  // the survey
+  at.now_s = b.now_s;
+  at.pose = a.target;
+  const Action push = planner->Next(at, context_);
+  ASSERT_EQ(push.kind, ActionKind::kNavigate) << push.why;
+  EXPECT_TRUE(push.push && push.along_floor) << push.why;
+  const double front = push.target.x() + robot_.length_m / 2.0;
+  EXPECT_LT(front, 0.61 - 0.025);  // short of the barrier's near face
+  const double ball_r = 0.5 * season_.FindObjectType("buckyball")->size_m;
+  EXPECT_TRUE(platform::GoalContains(season_.goals[Goal("goal_zone")],
+                                     Eigen::Vector2d(front + ball_r, ball.y())));
+  EXPECT_TRUE(platform::FootprintIsFree(season_,
+                                        platform::Pose2D{push.target.x(), push.target.y(), 0.0},
+                                        robot_.length_m, robot_.width_m, robot_.height_m));
+  // Done once: not pushed again.
+  planner->Feedback(push, true);
+  const Action after = planner->Next(at, context_);
+  EXPECT_FALSE(after.kind == ActionKind::kNavigate && after.object_id == 7) << after.why;
+
+  const Action blocked = decide(true, true).first;
+  EXPECT_FALSE(blocked.kind == ActionKind::kNavigate && blocked.along_floor) << blocked.why;
+  const Action off = decide(false, false).first;
+  EXPECT_FALSE(off.kind == ActionKind::kNavigate && off.along_floor) << off.why;
+}
+
 // The intake takes the object whose near edge is nearest the bumper across the robot's width:
 // a blue ball beside the red target, as near, would be taken instead. The approach comes from
 // a side where the target is alone in the corridor (straight on from the west it was not).
@@ -224,6 +300,7 @@ TEST_F(StrategyTest, APickIsApproachedFromASideWhereTheTargetIsAloneInTheCorrido
   const auto first_navigation = [&](const std::string& name, bool with_neighbour) {
     StrategyOptions options;
     options.raised_priors = false;  // the barrier balls would be worth more
+    options.floor_pushes = false;   // the picks' approach only
     std::unique_ptr<Strategy> strategy = MakeStrategy(name, options);
     Belief b;
     b.pose = Eigen::Vector3d(-0.45, 0.2, M_PI / 2.0);
@@ -274,6 +351,7 @@ TEST_F(StrategyTest, TheLearnedSuccessModelDecidesWhetherAPickIsWorthIt) {
   };
   StrategyOptions options;
   options.raised_priors = false;  // the barrier balls would be worth more
+  options.floor_pushes = false;   // a push of the ball (into the middle zone) needs no pick
   int asked = 0;
   options.learned_success = [&](const std::string& action, const std::string& kind, double range,
                                 double, double sigma) -> std::optional<double> {

@@ -432,6 +432,35 @@ TEST(Executive, TheV5RobotReentersALongGoalAlongItsAxisAndBacksUpShortLegs) {
   EXPECT_LT(drive_back(backwards), drive_back(forwards) - 0.5);
 }
 
+// Toss Up seed 7: after knocking the first large ball off the barrier, the planner finds a red
+// buckyball on the floor just short of the barrier and pushes it under into the goal zone
+// (2 points there, 1 where it lay). The attempt is judged on the simulator's ball, and the
+// match gains 2 more than the same seed without floor pushes (the other knock still lands).
+TEST(Executive, APushAlongTheFloorIsJudgedAndScores) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  const auto run = [&](bool pushes) {
+    MatchSetup setup;
+    setup.strategy = "planner";
+    setup.strategy_options.floor_pushes = pushes;
+    return RunMatch(season, robot, setup, 7);
+  };
+  const MatchResult with = run(true), without = run(false);
+  int pushes = 0, scored = 0;
+  for (const AttemptCheck& a : with.attempts) {
+    if (a.action != "PUSH") continue;
+    ++pushes;
+    scored += a.outcome == "scored";
+    EXPECT_EQ(a.kind, "buckyball");
+    EXPECT_GE(a.target_truth_id, 0);
+  }
+  EXPECT_EQ(pushes, 1);
+  EXPECT_EQ(scored, 1);
+  for (const AttemptCheck& a : without.attempts) EXPECT_NE(a.action, "PUSH");
+  EXPECT_EQ(with.points - with.points_start, without.points - without.points_start + 2);
+  EXPECT_EQ(with.overrun_s, 0.0);
+}
+
 // High Stakes with the V5 robot: the scripted route releases the preload and a picked ring
 // onto a mobile goal's stake (the stakes stand on their bases and move with them; before, the
 // robot pushed the base away from a stake that stayed put, and released onto the floor).
