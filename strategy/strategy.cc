@@ -976,15 +976,22 @@ class GreedyStrategy : public Base {
   int frames_;
 };
 
+StrategyOptions WithoutFloorPushes(StrategyOptions options) {
+  options.floor_pushes = false;
+  return options;
+}
+
 // A fixed route from the season's nominal positions, planned once before the match, driven
 // blind: what a team's scripted autonomous does. A team authors the route that scores most in
 // the period on the field as drawn; here that is a beam search over sequences of cycles (the
 // preload's release, picks and releases, knocks off raised structures), each timed with the
 // planner's travel times like every strategy's, keeping the sequence with the most points that
-// finishes by the deadline.
+// finishes by the deadline. No floor pushes: planned at the nominal spots, where the search
+// takes them for certain, they made the route worse (Toss Up, 200 seeds: gained 8.80 with them
+// against 10.72 without; 80 of 200 scored), and a team keeps the route that scores more.
 class ScriptedStrategy : public Base {
  public:
-  using Base::Base;
+  explicit ScriptedStrategy(const StrategyOptions& options) : Base(WithoutFloorPushes(options)) {}
   std::string name() const override { return "scripted"; }
   bool perceives() const override { return false; }
 
