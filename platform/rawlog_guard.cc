@@ -1,13 +1,18 @@
 #include "platform/rawlog_guard.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -15,6 +20,10 @@
 #include <sstream>
 
 #include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CRawlog.h>
+#include <mrpt/poses/CPosePDFParticles.h>
 #include <mrpt/serialization/CArchive.h>
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -33,6 +42,32 @@ namespace {
 // size. (Not under AddressSanitizer, whose shadow memory fills the address space.)
 constexpr uint64_t kChildBudgetBytes = 1ull << 30;
 constexpr int kExitTooBig = 5;
+
+// MRPT rebuilds an odometry movement of the "Thrun" motion model by drawing as many particles
+// as a uint32 in the record says (CActionRobotMovement2D::serializeFrom calls
+// computeFromOdometry), so a record of under 200 bytes can ask for billions: 15 million take
+// about 4 s and 700 MB (replay_rawlog_fuzzer's slow inputs). MRPT's default is 300; more than
+// this is a corrupt count, and the file is refused instead of being read again in-process.
+constexpr size_t kMaxParticles = 100000;
+constexpr int kExitTooManyParticles = 6;
+
+// The most particles that a robot movement in `object` holds (nested action collections and
+// rawlogs included).
+size_t MostParticles(const mrpt::serialization::CSerializable* object) {
+  using namespace mrpt::obs;  // NOLINT(build/namespaces): the MRPT classes, briefly
+  size_t most = 0;
+  if (const auto* move = dynamic_cast<const CActionRobotMovement2D*>(object)) {
+    if (const auto* particles =
+            dynamic_cast<const mrpt::poses::CPosePDFParticles*>(move->poseChange.get())) {
+      most = particles->size();
+    }
+  } else if (const auto* actions = dynamic_cast<const CActionCollection*>(object)) {
+    for (const auto& action : *actions) most = std::max(most, MostParticles(action.get()));
+  } else if (const auto* rawlog = dynamic_cast<const CRawlog*>(object)) {
+    for (const auto& entry : *rawlog) most = std::max(most, MostParticles(entry.get()));
+  }
+  return most;
+}
 
 void LimitAddressSpace() {
 #ifndef SLAMO_RAWLOG_GUARD_ASAN
@@ -56,7 +91,14 @@ void LimitAddressSpace() {
     ::dup2(devnull, STDOUT_FILENO);
     ::dup2(devnull, STDERR_FILENO);
   }
-  for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+  // SIGALRM too: a host that handles it (libFuzzer does, for its -timeout) would otherwise
+  // swallow the backstop alarm below. The parent's deadline is what bounds the read.
+  for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGALRM})
+    std::signal(sig, SIG_DFL);
+  sigset_t alarm_only;
+  sigemptyset(&alarm_only);
+  sigaddset(&alarm_only, SIGALRM);
+  ::sigprocmask(SIG_UNBLOCK, &alarm_only, nullptr);
   ::alarm(timeout_s);
   LimitAddressSpace();
   try {
@@ -66,7 +108,8 @@ void LimitAddressSpace() {
     for (uint32_t record = 1;; ++record) {
       if (::write(report_fd, &record, sizeof(record)) != sizeof(record)) ::_exit(4);
       try {
-        archive.ReadObject();
+        const auto object = archive.ReadObject();
+        if (MostParticles(object.get()) > kMaxParticles) ::_exit(kExitTooManyParticles);
       } catch (const mrpt::serialization::CExceptionEOF&) {
         ::_exit(0);
       }
@@ -110,11 +153,32 @@ std::optional<std::string> CheckRawlogInChildProcess(const std::string& path, do
   }
   if (pid == 0) {
     ::close(fds[0]);
-    ReadInChild(path, fds[1], static_cast<unsigned>(timeout_s > 1.0 ? timeout_s : 1.0));
+    // A backstop should this process die first; the deadline below comes before it.
+    ReadInChild(path, fds[1], static_cast<unsigned>(std::ceil(std::max(timeout_s, 0.0))) + 1);
   }
   ::close(fds[1]);
+  // The deadline is kept here, not by a signal in the child: a SIGALRM handler or ignored
+  // SIGALRM that the child inherits (libFuzzer handles SIGALRM) would let it run on.
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(std::max(timeout_s, 0.0)));
+  bool timed_out = false;
   uint32_t record = 0, got = 0;
   for (;;) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+    if (left <= 0) {
+      timed_out = true;
+      break;
+    }
+    pollfd ready{fds[0], POLLIN, 0};
+    const int n_ready = ::poll(&ready, 1, static_cast<int>(std::min<int64_t>(left, 1000)));
+    if (n_ready == 0 || (n_ready < 0 && errno == EINTR)) continue;
+    if (n_ready < 0) {  // cannot wait (poll failed): stop the child, as at the deadline
+      timed_out = true;
+      break;
+    }
     const ssize_t n = ::read(fds[0], &got, sizeof(got));
     if (n == static_cast<ssize_t>(sizeof(got))) {
       record = got;
@@ -125,14 +189,25 @@ std::optional<std::string> CheckRawlogInChildProcess(const std::string& path, do
     }
   }
   ::close(fds[0]);
+  if (timed_out) ::kill(pid, SIGKILL);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) return std::nullopt;
   }
   const std::string where = " reading record " + std::to_string(record);
+  char seconds[32];
+  std::snprintf(seconds, sizeof(seconds), "%g", timeout_s);
+  if (timed_out) {
+    return std::string("MRPT's rawlog deserialiser took more than ") + seconds +
+           " s (a corrupt count?)" + where;
+  }
   if (WIFEXITED(status)) {
     const int code = WEXITSTATUS(status);
     if (code == 0 || code == 3) return std::nullopt;
+    if (code == kExitTooManyParticles) {
+      return "a robot movement asks MRPT's rawlog deserialiser to draw more than " +
+             std::to_string(kMaxParticles) + " particles (a corrupt count?)" + where;
+    }
     if (code == kExitTooBig) {
       return "a record asks MRPT's rawlog deserialiser for more than " +
              std::to_string(kChildBudgetBytes >> 20) + " MiB (a corrupt size?)" + where;
@@ -143,8 +218,7 @@ std::optional<std::string> CheckRawlogInChildProcess(const std::string& path, do
   if (WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
     if (sig == SIGALRM) {
-      return "MRPT's rawlog deserialiser hung (more than " +
-             std::to_string(static_cast<int>(timeout_s)) + " s)" + where;
+      return std::string("MRPT's rawlog deserialiser hung (more than ") + seconds + " s)" + where;
     }
     const char* name = sigabbrev_np(sig);
     return std::string("MRPT's rawlog deserialiser crashed (SIG") + (name ? name : "?") + ")" +

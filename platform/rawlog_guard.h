@@ -1,9 +1,10 @@
 // MRPT's rawlog deserialisers trust the file: a corrupt record can crash them (a SEGV in
 // CActionRobotMovement2D::serializeFrom, tests/fuzz/known_crashes/), hang them or make them
-// allocate gigabytes, inside MRPT, before any of our code sees the object. So every rawlog is
-// first read to its end in a child process; only a file the child read without crashing is
-// read again in this process. Costs one more pass over the file (a 36 MB rawlog: about a
-// second); a crash or hang costs the child, never the program.
+// allocate gigabytes or draw millions of samples, inside MRPT, before any of our code sees
+// the object. So every rawlog is first read to its end in a child process; only a file the
+// child read without crashing, in time, is read again in this process. Costs one more pass
+// over the file (a 36 MB rawlog: about a second); a crash or hang costs the child, never the
+// program.
 #pragma once
 
 #include <optional>
@@ -14,9 +15,11 @@ namespace slamo::platform {
 // Reads every record of the rawlog at `path` with MRPT in a child process. Nothing when the
 // child reached the end or stopped on an error MRPT reports as an exception (the caller's own
 // reader then reports it); otherwise what happened, for the caller's error: "MRPT's rawlog
-// deserialiser crashed (SIGSEGV) reading record 3", hung for more than timeout_s, or asked
-// for more than 1 GiB for one record (a corrupt size: the child's address space is limited,
-// except under AddressSanitizer).
+// deserialiser crashed (SIGSEGV) reading record 3", took more than timeout_s (this process
+// keeps the deadline and kills the child, whatever the child's signal handlers), asked for
+// more than 1 GiB for one record (a corrupt size: the child's address space is limited,
+// except under AddressSanitizer), or made MRPT draw more than 100000 particles for one robot
+// movement (a corrupt count in the record; MRPT's default is 300).
 std::optional<std::string> CheckRawlogInChildProcess(const std::string& path,
                                                      double timeout_s = 120.0);
 

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -11,6 +13,8 @@
 #include <mrpt/core/Clock.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationBearingRange.h>
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/serialization/CArchive.h>
@@ -381,6 +385,63 @@ TEST(RawlogTest, ARecordThatCrashesMrptGivesAnErrorNotACrash) {
     EXPECT_NE(std::string(e.what()).find("MRPT's rawlog deserialiser"), std::string::npos)
         << e.what();
   }
+}
+
+// A rawlog of one odometry movement of MRPT's "Thrun" motion model: MRPT stores the model's
+// particle count, not the particles, and draws that many when it reads the record back. A file
+// of under 200 bytes can so ask for millions (replay_rawlog_fuzzer's slow inputs: 15 million
+// took 10 s under the fuzzer, past its 2 s check, since the check's alarm went to libFuzzer's
+// SIGALRM handler).
+std::string ThrunMovementRawlog(const std::string& name, uint32_t particles) {
+  const std::string path = TempPath(name);
+  mrpt::io::CFileOutputStream file(path);
+  auto archive = mrpt::serialization::archiveFrom(file);
+  mrpt::obs::CActionRobotMovement2D move;
+  move.timestamp = mrpt::Clock::fromDouble(1.0);
+  move.estimationMethod = mrpt::obs::CActionRobotMovement2D::emOdometry;
+  move.rawOdometryIncrementReading = mrpt::poses::CPose2D(0.1, 0.0, 0.01);
+  move.motionModelConfiguration.modelSelection = mrpt::obs::CActionRobotMovement2D::mmThrun;
+  move.motionModelConfiguration.thrunModel.nParticlesCount = particles;
+  mrpt::obs::CActionCollection actions;
+  actions.insert(move);
+  archive << actions;
+  return path;
+}
+
+TEST(RawlogTest, AMovementOfMoreThan100000ParticlesIsACorruptCount) {
+  // 300 particles (MRPT's default) read as a step; 200000 are refused, naming the count.
+  EXPECT_EQ(ReadRawlog(ThrunMovementRawlog("thrun300.rawlog", 300)).events.size(), 1u);
+  ExpectRawlogError(ThrunMovementRawlog("thrun200k.rawlog", 200000),
+                    "draw more than 100000 particles (a corrupt count?) reading record 1");
+}
+
+void IgnoreSignal(int) {}
+
+// The check's time limit holds even when the program handles SIGALRM itself, as libFuzzer
+// does: the parent kills the child at the deadline. 15 million particles take MRPT about 4 s
+// (and 700 MB); the read must end near the 0.5 s limit instead.
+TEST(RawlogTest, TheCheckStopsASlowRecordAtItsDeadlineWhateverTheSignalHandlers) {
+  const std::string path = ThrunMovementRawlog("thrun15m.rawlog", 15000000);
+  struct sigaction handler = {}, previous = {};
+  handler.sa_handler = IgnoreSignal;
+  sigemptyset(&handler.sa_mask);
+  ASSERT_EQ(sigaction(SIGALRM, &handler, &previous), 0);
+  ReplayLogOptions options;
+  options.rawlog_check_timeout_s = 0.5;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    ReadRawlog(path, options);
+    ADD_FAILURE() << "expected an error for " << path;
+  } catch (const ReplayLogError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("took more than 0.5 s (a corrupt count?) reading record 1"),
+        std::string::npos)
+        << e.what();
+  }
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  sigaction(SIGALRM, &previous, nullptr);
+  EXPECT_LT(elapsed_s, 3.0);
 }
 
 }  // namespace
