@@ -108,7 +108,7 @@ int DryRun(const DryRunArgs& args) {
   }
   if (!CreateOutputDir(args.out)) return 1;
   std::cout << "dry run: " << season.name << " (" << season.season << "), seed " << args.seed
-            << ", strategy " << args.strategy << ", " << season.rules.autonomous_s
+            << ", strategy " << setup.strategy << ", " << season.rules.autonomous_s
             << " s autonomous, " << ScenarioName(setup.scenario) << " layout\n";
   const MatchResult result =
       RunMatch(season, robot, setup, args.seed, args.out, [&](const TimelineEntry& e) {
