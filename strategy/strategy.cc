@@ -1101,18 +1101,14 @@ class ScriptedStrategy : public Base {
       nav.object_kind = o.kind;
       nav.object_colour = o.colour;
       nav.object_m = o.position_m;
-      nav.why = cycle.along_floor ? "script: to push nominal " + o.colour + " " + o.kind
-                                  : "script: to knock nominal " + o.colour + " " + o.kind + " off";
+      nav.why = "script: to knock nominal " + o.colour + " " + o.kind + " off";
       route_.push_back(nav);
       Action push = nav;
       push.push = true;
-      push.along_floor = cycle.along_floor;
       push.target = cycle.push_end;
       push.goal_index = cycle.goal;
-      push.expected_s = cycle.along_floor ? cycle.push_s : PushSeconds(c);
-      push.why =
-          std::string(cycle.along_floor ? "script: push it into " : "script: knock it into ") +
-          c.season->goals[cycle.goal].name;
+      push.expected_s = PushSeconds(c);
+      push.why = "script: knock it into " + c.season->goals[cycle.goal].name;
       route_.push_back(push);
       return;
     }
