@@ -24,6 +24,42 @@ double TrimmedExtent(std::vector<float>* values, double trim, double* low = null
   return (*values)[hi] - bottom;
 }
 
+// Connected components of footprint cells (cell centres, `cell` apart on a grid): two cells
+// are linked when at most `link` cells apart along both axes. Labels 0..n-1, by first cell.
+std::vector<int> FootprintComponents(const std::vector<cv::Point2f>& cells, double cell, int link) {
+  std::map<std::pair<int, int>, int> index;
+  std::vector<std::pair<int, int>> at(cells.size());
+  for (size_t i = 0; i < cells.size(); ++i) {
+    at[i] = {static_cast<int>(std::lround(cells[i].x / cell - 0.5)),
+             static_cast<int>(std::lround(cells[i].y / cell - 0.5))};
+    index[at[i]] = static_cast<int>(i);
+  }
+  std::vector<int> label(cells.size(), -1), stack;
+  int next = 0;
+  for (size_t seed = 0; seed < cells.size(); ++seed) {
+    if (label[seed] >= 0) continue;
+    label[seed] = next;
+    stack.assign(1, static_cast<int>(seed));
+    while (!stack.empty()) {
+      const auto [x, y] = at[stack.back()];
+      stack.pop_back();
+      // The cells of columns x - link .. x + link, rows y - link .. y + link.
+      for (int dx = -link; dx <= link; ++dx) {
+        auto it = index.lower_bound({x + dx, y - link});
+        for (; it != index.end() && it->first.first == x + dx && it->first.second <= y + link;
+             ++it) {
+          if (label[it->second] < 0) {
+            label[it->second] = next;
+            stack.push_back(it->second);
+          }
+        }
+      }
+    }
+    ++next;
+  }
+  return label;
+}
+
 }  // namespace
 
 SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
@@ -140,34 +176,51 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
     }
     return true;
   };
+  // Footprints apart on the floor are different objects, however they overlap in the image:
+  // each level's cells are linked into components (cells within link_fraction x the width of
+  // each other), and the fewest groups are sought within each component.
+  const int link_cells =
+      std::max(1, static_cast<int>(std::ceil(options.link_fraction / options.cell_size - 1e-9)));
   std::vector<std::vector<cv::Point2f>> level_centres(levels);
+  std::vector<cv::Point2f> part;
   int k_total = 0;
-  for (int level = 0; level < levels; ++level) {
-    const std::vector<cv::Point2f>& pts = level_points[level];
-    if (static_cast<int>(pts.size()) < options.min_level_points) continue;
-    std::vector<int> labels(pts.size(), 0);
-    cv::Point2f mean(0, 0);
-    for (const cv::Point2f& q : pts) mean += q;
-    std::vector<cv::Point2f> centres{mean * (1.0f / pts.size())};
-    const cv::Mat data(static_cast<int>(pts.size()), 2, CV_32F,
-                       const_cast<cv::Point2f*>(pts.data()));
-    const int most = std::min(options.max_objects - k_total, static_cast<int>(pts.size()));
-    int k = 1;
-    while (!fits(pts, labels, k) && k < most) {
-      ++k;
-      cv::Mat fit_labels, fit_centres;
-      cv::theRNG().state = 0x5eed + k;  // k-means++ seeding: the same groups for the same blob
-      cv::kmeans(data, k, fit_labels,
-                 cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
-                                  options.kmeans_iterations, 1e-3),
-                 1, cv::KMEANS_PP_CENTERS, fit_centres);
-      for (size_t i = 0; i < pts.size(); ++i) labels[i] = fit_labels.at<int>(static_cast<int>(i));
-      centres.assign(k, cv::Point2f());
-      for (int c = 0; c < k; ++c) centres[c] = fit_centres.at<cv::Point2f>(c);
+  for (int level = 0; level < levels && k_total < options.max_objects; ++level) {
+    const std::vector<cv::Point2f>& cells = level_points[level];
+    if (static_cast<int>(cells.size()) < options.min_level_points) continue;
+    const std::vector<int> component =
+        options.link_fraction > 0.0 ? FootprintComponents(cells, options.cell_size, link_cells)
+                                    : std::vector<int>(cells.size(), 0);
+    const int components = *std::max_element(component.begin(), component.end()) + 1;
+    for (int c = 0; c < components && k_total < options.max_objects; ++c) {
+      part.clear();
+      for (size_t i = 0; i < cells.size(); ++i) {
+        if (component[i] == c) part.push_back(cells[i]);
+      }
+      // Too few cells for an object of its own: its points join the nearest group.
+      if (static_cast<int>(part.size()) < options.min_level_points) continue;
+      std::vector<int> labels(part.size(), 0);
+      cv::Point2f mean(0, 0);
+      for (const cv::Point2f& q : part) mean += q;
+      std::vector<cv::Point2f> centres{mean * (1.0f / part.size())};
+      const cv::Mat data(static_cast<int>(part.size()), 2, CV_32F, part.data());
+      const int most = std::min(options.max_objects - k_total, static_cast<int>(part.size()));
+      int k = 1;
+      while (!fits(part, labels, k) && k < most) {
+        ++k;
+        cv::Mat fit_labels, fit_centres;
+        cv::theRNG().state = 0x5eed + k;  // k-means++ seeding: the same groups for the same blob
+        cv::kmeans(data, k, fit_labels,
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
+                                    options.kmeans_iterations, 1e-3),
+                   1, cv::KMEANS_PP_CENTERS, fit_centres);
+        for (size_t i = 0; i < part.size(); ++i)
+          labels[i] = fit_labels.at<int>(static_cast<int>(i));
+        centres.assign(k, cv::Point2f());
+        for (int j = 0; j < k; ++j) centres[j] = fit_centres.at<cv::Point2f>(j);
+      }
+      level_centres[level].insert(level_centres[level].end(), centres.begin(), centres.end());
+      k_total += k;
     }
-    level_centres[level] = centres;
-    k_total += k;
-    if (k_total >= options.max_objects) break;
   }
   if (k_total == 0) return result;
   // The top level is seen from above (the camera is higher than any stack): each of its

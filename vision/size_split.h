@@ -49,7 +49,12 @@ struct SizeSplitOptions {
   // The blob's bottom (its 3rd percentile) at most this x the object's height above the floor:
   // objects rest on it, so a blob raised off it is something else of their colour.
   double floor_tolerance = 0.5;
-  int min_level_points = 4;  // a stack level with fewer footprint cells has no objects of its own
+  int min_level_points = 4;  // a stack level (or a part of one apart from the rest on the
+                             // floor) with fewer footprint cells has no objects of its own
+  // Footprint cells within this x the object's width of each other belong to one part of a
+  // level; parts further apart on the floor are never one object (objects that overlap in
+  // the image, one behind another, but lie apart). 0: a level is one part.
+  double link_fraction = 0.5;
 };
 
 struct SizeSplitResult {
