@@ -54,8 +54,17 @@ void MakeTouchingPair(platform::SimWorld* world, std::mt19937_64* rng) {
       continue;
     const double angle = 2.0 * M_PI * unit(*rng);
     const double d = a.type->size_m * 1.001;
-    b.center_m.x() = a.center_m.x() + d * std::cos(angle);
-    b.center_m.y() = a.center_m.y() + d * std::sin(angle);
+    const Eigen::Vector2d from = b.center_m.head<2>();
+    const Eigen::Vector2d to(a.center_m.x() + d * std::cos(angle),
+                             a.center_m.y() + d * std::sin(angle));
+    // What rests on b (a stack of rings) goes with it: nothing is left floating.
+    for (SimObject& o : objects) {
+      if (&o != &b && o.center_m.z() > b.center_m.z() &&
+          (o.center_m.head<2>() - from).norm() < b.type->size_m / 2.0) {
+        o.center_m.head<2>() += to - from;
+      }
+    }
+    b.center_m.head<2>() = to;
     return;
   }
 }
@@ -113,6 +122,35 @@ int TruthIdUnder(const vision::Detection& d, const cv::Mat& ids) {
     if (id > 0 && id < platform::kLandmarkIdBase && n > best_votes) best_id = id, best_votes = n;
   }
   return best_votes * 2 >= total ? best_id : 0;
+}
+
+// What a false detection lies on, by most of its pixels: objects of its own colour (a second
+// detection on a found object, a piece of one, or one spanning two), an opponent robot, or
+// anything else (structures, the field, the stands, objects of another colour).
+enum class FalseOn { kPiece, kRobot, kOther };
+FalseOn FalseDetectionOn(const vision::Detection& d, const cv::Mat& ids,
+                         const std::map<int, const SimObject*>& object_of) {
+  const cv::Rect box = d.box & cv::Rect(0, 0, ids.cols, ids.rows);
+  cv::Mat mask(box.size(), CV_8UC1, cv::Scalar(0));
+  cv::drawContours(mask, std::vector<std::vector<cv::Point>>{d.contour}, 0, cv::Scalar(255),
+                   cv::FILLED, cv::LINE_8, cv::noArray(), 0, -box.tl());
+  int piece = 0, robot = 0, total = 0;
+  for (int v = 0; v < box.height; ++v) {
+    for (int u = 0; u < box.width; ++u) {
+      if (!mask.at<uint8_t>(v, u)) continue;
+      const int id = ids.at<uint16_t>(v + box.y, u + box.x);
+      ++total;
+      if (id >= platform::kOpponentIdBase) {
+        ++robot;
+      } else if (id > 0 && id < platform::kLandmarkIdBase) {
+        const auto it = object_of.find(id);
+        piece += it != object_of.end() && it->second->colour == d.colour;
+      }
+    }
+  }
+  if (2 * piece > total) return FalseOn::kPiece;
+  if (2 * robot > total) return FalseOn::kRobot;
+  return FalseOn::kOther;
 }
 
 void Label(cv::Mat* image, const std::string& text, cv::Point at, const cv::Scalar& colour) {
@@ -280,6 +318,17 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
         if (!hit) {
           ++s.false_positives;
           false_kept.push_back(&d);
+          switch (FalseDetectionOn(d, truth.ids, object_of)) {
+            case FalseOn::kPiece:
+              ++s.false_pieces;
+              break;
+            case FalseOn::kRobot:
+              ++s.false_on_robots;
+              break;
+            case FalseOn::kOther:
+              ++s.false_other;
+              break;
+          }
           continue;
         }
         ++s.true_positives;
@@ -397,10 +446,11 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
 std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores) {
   std::string out;
   char line[320];
-  std::snprintf(line, sizeof(line), "%-19s %9s %8s %8s %9s %6s %6s %6s %6s %7s %7s %8s %9s  %s\n",
-                "method", "precision", "no_gate", "rejected", "structure", "wrong", "recall",
-                "solid", "semi", "hidden", "groups", "count_ok", "centre_px",
-                "position error m: <1m  1-2m  2-3m  3m+");
+  std::snprintf(line, sizeof(line),
+                "%-19s %9s %8s %8s %9s %6s %6s %6s %6s %6s %6s %6s %6s %7s %7s %8s %9s  %s\n",
+                "method", "precision", "no_gate", "rejected", "structure", "wrong", "false",
+                "piece", "robot", "other", "recall", "solid", "semi", "hidden", "groups",
+                "count_ok", "centre_px", "position error m: <1m  1-2m  2-3m  3m+");
   out += line;
   for (const VisionMethodScore& s : scores) {
     const auto ratio = [](int a, int b) { return b ? static_cast<double>(a) / b : 0.0; };
@@ -416,9 +466,11 @@ std::string FormatVisionTable(const std::vector<VisionMethodScore>& scores) {
       bands += cell;
     }
     std::snprintf(line, sizeof(line),
-                  "%-19s %9.3f %8.3f %8d %9d %6d %6.3f %6.3f %6.3f %7.3f %7d %8.3f %9.2f  %s\n",
+                  "%-19s %9.3f %8.3f %8d %9d %6d %6d %6d %6d %6d %6.3f %6.3f %6.3f %7.3f %7d %8.3f "
+                  "%9.2f  %s\n",
                   s.name.c_str(), s.Precision(), s.RawPrecision(), s.rejected_by_geometry,
-                  s.rejected_structure, s.rejected_objects, s.Recall(),
+                  s.rejected_structure, s.rejected_objects, s.false_positives, s.false_pieces,
+                  s.false_on_robots, s.false_other, s.Recall(),
                   ratio(s.found_solid, s.expected_solid), ratio(s.found_semi, s.expected_semi),
                   ratio(s.found_hidden, s.expected_hidden), s.groups,
                   ratio(s.groups_counted, s.groups),

@@ -58,6 +58,9 @@ struct VisionMethodScore {
   vision::SeparationMethod separation = vision::SeparationMethod::kConcaveDefects;
   int true_positives = 0;  // after the field gate
   int false_positives = 0;
+  // ... of which lie mostly on objects of their colour (a second detection on one, a piece of
+  // one, one spanning two), mostly on an opponent robot, or on anything else.
+  int false_pieces = 0, false_on_robots = 0, false_other = 0;
   int raw_true_positives = 0;  // without the gate
   int raw_false_positives = 0;
   int rejected_by_geometry = 0;  // detections the gate dropped
