@@ -262,6 +262,68 @@ std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlie
   return fit;
 }
 
+// Objects rest on something. Just under the lowest pixels of an object on the floor the camera
+// sees the floor in front of its foot (nearer); under one on a goal or another object, what
+// holds it; under one whose foot is hidden, what hides it: never much farther than the
+// object's own bottom. Under a thing held off the floor with nothing beneath it (a robot's
+// bumper) the first rows see the floor behind the gap, farther away. A column of the blob
+// floats when the farthest of the `float_below_rows` rows under its lowest pixel lies more
+// than `float_margin_m` plus 3 sigma of the depth noise beyond the nearest of its own three
+// lowest rows. Returns, per column of `blob_mask`, 1 where it floats (0 where it does not or
+// cannot be told: no readings, or the image ends under it).
+std::vector<uint8_t> FloatingColumns(const cv::Mat& blob_mask, cv::Point offset,
+                                     const cv::Mat& depth_mm, const CameraModel& camera,
+                                     const DetectOptions& options) {
+  constexpr int kOwnRows = 3;
+  const int below_rows = options.float_below_rows;
+  std::vector<uint8_t> floating(blob_mask.cols, 0);
+  for (int u = 0; u < blob_mask.cols; ++u) {
+    int bottom = -1;
+    for (int v = blob_mask.rows - 1; v >= 0; --v) {
+      if (blob_mask.at<uint8_t>(v, u)) {
+        bottom = v;
+        break;
+      }
+    }
+    if (bottom < 0) continue;
+    const int x = u + offset.x, y = bottom + offset.y;
+    if (y + below_rows >= depth_mm.rows) continue;  // the image ends under it: cannot tell
+    double own = std::numeric_limits<double>::infinity();
+    for (int v = std::max(0, bottom - kOwnRows + 1); v <= bottom; ++v) {
+      const uint16_t raw = depth_mm.at<uint16_t>(v + offset.y, x);
+      if (raw && blob_mask.at<uint8_t>(v, u)) own = std::min(own, camera.CorrectDepthM(raw));
+    }
+    double below = -std::numeric_limits<double>::infinity();
+    for (int k = 1; k <= below_rows; ++k) {
+      const uint16_t raw = depth_mm.at<uint16_t>(y + k, x);
+      if (raw) below = std::max(below, camera.CorrectDepthM(raw));
+    }
+    if (!std::isfinite(own) || !std::isfinite(below)) continue;
+    floating[u] = below - own > options.float_margin_m + 3.0 * camera.DepthSigmaM(own);
+  }
+  return floating;
+}
+
+// Clears from `blob_mask` every run of at least `min_run` floating columns (FloatingColumns);
+// true when any was cleared.
+bool ClearFloatingRuns(const std::vector<uint8_t>& floating, int min_run, cv::Mat* blob_mask) {
+  bool cleared = false;
+  for (int u = 0; u < static_cast<int>(floating.size());) {
+    if (!floating[u]) {
+      ++u;
+      continue;
+    }
+    int end = u;
+    while (end < static_cast<int>(floating.size()) && floating[end]) ++end;
+    if (end - u >= min_run) {
+      (*blob_mask)(cv::Rect(u, 0, end - u, blob_mask->rows)).setTo(0);
+      cleared = true;
+    }
+    u = end;
+  }
+  return cleared;
+}
+
 // An object resting on the floor seen without depth: each kind has a range on the ground plane
 // (the plane of its centre); the kind whose apparent size fits best at its own range, within
 // the size tolerance, sets the detection's kind and measurement. False when none fits.
@@ -549,11 +611,19 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
     double min_circularity = 1.0;
     for (const TargetKind& k : kinds)
       min_circularity = std::min(min_circularity, k.min_circularity);
+    const bool all_solid =
+        std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.solid; });
+    const bool none_round =
+        std::none_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
     std::vector<std::vector<cv::Point>> blobs;
     // OpenCV 4 leaves the image unchanged: no copy of the mask.
     cv::findContours(masks[j], blobs, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-    for (const std::vector<cv::Point>& blob : blobs) {
+    // Blobs found in the mask; what is left of one after its floating part is cleared is
+    // appended, and not tested again.
+    const size_t found_blobs = blobs.size();
+    for (size_t b = 0; b < blobs.size(); ++b) {
+      const std::vector<cv::Point>& blob = blobs[b];
       const double blob_area = cv::contourArea(blob);
       if (blob_area < options.min_area_px) {
         ++st.rejected_small;
@@ -610,6 +680,29 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         }
       }
 
+      // Nothing floats: the part of a blob held off the floor over nothing (a robot's bumper,
+      // alone or touching an object of its colour) is not an object, and is cleared; what is
+      // left is looked at as blobs of its own. Only for solid kinds (depth reads their
+      // surface) with a flat base, not round ones (a ball or a triball shows the floor under
+      // its curve; the bulge test judges those).
+      if (options.drop_floating && b < found_blobs && blob_depth_m > 0.0 && all_solid &&
+          none_round) {
+        cv::Mat kept = blob_mask.clone();
+        // A run narrower than this may be the overhang of an object on a thin support (a cube
+        // on a post): left.
+        const int min_run = std::max(
+            options.float_min_columns,
+            static_cast<int>(std::ceil(options.float_min_run_widths * 2.0 * expected_radius_px)));
+        if (ClearFloatingRuns(
+                FloatingColumns(blob_mask, window.tl(), depth_mm, *setup.camera, options), min_run,
+                &kept)) {
+          ++st.rejected_floating;
+          std::vector<std::vector<cv::Point>> rest;
+          cv::findContours(kept, rest, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, window.tl());
+          for (std::vector<cv::Point>& r : rest) blobs.push_back(std::move(r));  // `blob` dangles
+          continue;
+        }
+      }
       const bool all_round =
           std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
@@ -618,8 +711,6 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       // Kinds that are not round (rings, cubes, stars, blocks) have concave outlines of their
       // own: with depth, when none of the colour's kinds is round, a blob no wider and no
       // taller than one of them can look (its diagonal) is that one object, never cut.
-      const bool none_round =
-          std::none_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
       const bool one_object = none_round && largest_extent_px > 0.0 &&
                               box.width <= largest_extent_px + options.extent_margin_px &&
                               box.height <= largest_extent_px + options.extent_margin_px;

@@ -57,6 +57,20 @@ struct DetectOptions {
   // the kind's radius. A sphere's is about 0.28; a triball's least, a face turned to the
   // camera (a sphere of its width), about 0.12. 0 turns the test off.
   double min_bulge_ratio = 0.1;
+  // With depth, for colours of solid kinds with flat bases (no round kind: rings, cubes,
+  // blocks, goals): the part of a blob held off the floor over nothing is cleared (a robot's
+  // bumper, alone or touching an object). A column floats when the farthest of the
+  // float_below_rows rows under its lowest pixel lies float_margin_m plus 3 sigma of the depth
+  // noise beyond it (a ring's or block's foot stands on the floor in front of it; a ball or a
+  // triball shows floor under its curve, so round kinds are not tested); runs of at least
+  // float_min_columns floating columns, and at least float_min_run_widths of the largest
+  // kind's apparent width at the blob's depth, are cleared (a narrower run may be the
+  // overhang of an object on a thin support: a cube on a post).
+  bool drop_floating = true;
+  double float_margin_m = 0.02;
+  int float_below_rows = 2;
+  int float_min_columns = 5;
+  double float_min_run_widths = 0.5;
   // K-Means (thesis 5.2.2): clustering of the chromatic pixels in Lab a*b*.
   int kmeans_downsample = 0;           // cluster on an image this many times smaller; 0: about
                                        // 256 px wide (2x at 512x424, 8x at 1920x1080)
@@ -121,10 +135,11 @@ struct DetectStats {
   int rejected_small = 0;
   int rejected_shape = 0;
   int rejected_size = 0;
-  int rejected_flat = 0;  // round solid kinds whose surface does not curve (a bumper's face)
-  int split_by_size = 0;  // blobs separated by the objects' known size
-  int without_depth = 0;  // kept, but no range: no valid depth on them (or, without a depth
-                          // image, no kind resting on the floor fits their size)
+  int rejected_flat = 0;      // round solid kinds whose surface does not curve (a bumper's face)
+  int split_by_size = 0;      // blobs separated by the objects' known size
+  int rejected_floating = 0;  // blobs with a part held off the floor over nothing (cleared)
+  int without_depth = 0;      // kept, but no range: no valid depth on them (or, without a depth
+                              // image, no kind resting on the floor fits their size)
 };
 
 // Without a depth image but with a camera, each detection's range comes from the ground plane
