@@ -729,8 +729,13 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       }
       SizeSplitResult sized;
       if (size_extent) {
+        // Piles of round objects are clustered whole: a ball half hidden behind another shows
+        // a cap whose footprint lies apart from the front ball's crescent, and taking the
+        // footprint apart there cost Nothing but Net's arena precision 0.954 -> 0.939.
+        SizeSplitOptions split_options = options.size_split;
+        if (all_round) split_options.link_fraction = 0.0;
         sized = SplitBySize(blob_mask, depth_mm(window), window.tl(), *setup.camera, *size_extent,
-                            options.size_split);
+                            split_options);
         if (sized.objects > 1) ++st.split_by_size;
       }
       const bool convex =
