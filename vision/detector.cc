@@ -269,14 +269,15 @@ std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlie
 // bumper) the first rows see the floor behind the gap, farther away. A column of the blob
 // floats when the farthest of the `float_below_rows` rows under its lowest pixel lies more
 // than `float_margin_m` plus 3 sigma of the depth noise beyond the nearest of its own three
-// lowest rows. Returns, per column of `blob_mask`, 1 where it floats (0 where it does not or
-// cannot be told: no readings, or the image ends under it).
+// lowest rows. Returns, per column of `blob_mask`: kFloats, kStands, kUnknown (no readings,
+// or the image ends under it) or kEmpty (no blob pixel).
+enum ColumnSupport : uint8_t { kStands = 0, kFloats = 1, kUnknown = 2, kEmpty = 3 };
 std::vector<uint8_t> FloatingColumns(const cv::Mat& blob_mask, cv::Point offset,
                                      const cv::Mat& depth_mm, const CameraModel& camera,
                                      const DetectOptions& options) {
   constexpr int kOwnRows = 3;
   const int below_rows = options.float_below_rows;
-  std::vector<uint8_t> floating(blob_mask.cols, 0);
+  std::vector<uint8_t> floating(blob_mask.cols, kUnknown);
   for (int u = 0; u < blob_mask.cols; ++u) {
     int bottom = -1;
     for (int v = blob_mask.rows - 1; v >= 0; --v) {
@@ -285,7 +286,10 @@ std::vector<uint8_t> FloatingColumns(const cv::Mat& blob_mask, cv::Point offset,
         break;
       }
     }
-    if (bottom < 0) continue;
+    if (bottom < 0) {
+      floating[u] = kEmpty;
+      continue;
+    }
     const int x = u + offset.x, y = bottom + offset.y;
     if (y + below_rows >= depth_mm.rows) continue;  // the image ends under it: cannot tell
     double own = std::numeric_limits<double>::infinity();
@@ -299,22 +303,53 @@ std::vector<uint8_t> FloatingColumns(const cv::Mat& blob_mask, cv::Point offset,
       if (raw) below = std::max(below, camera.CorrectDepthM(raw));
     }
     if (!std::isfinite(own) || !std::isfinite(below)) continue;
-    floating[u] = below - own > options.float_margin_m + 3.0 * camera.DepthSigmaM(own);
+    floating[u] =
+        below - own > options.float_margin_m + 3.0 * camera.DepthSigmaM(own) ? kFloats : kStands;
   }
   return floating;
 }
 
 // Clears from `blob_mask` every run of at least `min_run` floating columns (FloatingColumns);
-// true when any was cleared.
-bool ClearFloatingRuns(const std::vector<uint8_t>& floating, int min_run, cv::Mat* blob_mask) {
+// true when any was cleared. Unknown columns next to floating ones float with them (they show
+// nothing standing), and gaps of at most `max_gap` standing columns between floating ones are
+// bridged (depth noise; a K-Means mask drawn at half resolution has ragged bottoms).
+bool ClearFloatingRuns(std::vector<uint8_t> support, int min_run, int max_gap, cv::Mat* blob_mask) {
+  const int n = static_cast<int>(support.size());
+  // Unknown runs touching a floating column; then short gaps between floating columns.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int u = 0; u < n;) {
+      if (support[u] == kFloats) {
+        ++u;
+        continue;
+      }
+      int end = u;
+      while (end < n && support[end] != kFloats) ++end;
+      // Floating on that side (not the blob's end: empty columns are never filled).
+      const bool left = u > 0, right = end < n;
+      if (std::any_of(support.begin() + u, support.begin() + end,
+                      [](uint8_t c) { return c == kEmpty; })) {
+        u = end;
+        continue;
+      }
+      bool fill = false;
+      if (pass == 0) {
+        fill = (left || right) && std::all_of(support.begin() + u, support.begin() + end,
+                                              [](uint8_t c) { return c == kUnknown; });
+      } else {
+        fill = left && right && end - u <= max_gap;
+      }
+      if (fill) std::fill(support.begin() + u, support.begin() + end, kFloats);
+      u = end;
+    }
+  }
   bool cleared = false;
-  for (int u = 0; u < static_cast<int>(floating.size());) {
-    if (!floating[u]) {
+  for (int u = 0; u < n;) {
+    if (support[u] != kFloats) {
       ++u;
       continue;
     }
     int end = u;
-    while (end < static_cast<int>(floating.size()) && floating[end]) ++end;
+    while (end < n && support[end] == kFloats) ++end;
     if (end - u >= min_run) {
       (*blob_mask)(cv::Rect(u, 0, end - u, blob_mask->rows)).setTo(0);
       cleared = true;
@@ -695,7 +730,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             static_cast<int>(std::ceil(options.float_min_run_widths * 2.0 * expected_radius_px)));
         if (ClearFloatingRuns(
                 FloatingColumns(blob_mask, window.tl(), depth_mm, *setup.camera, options), min_run,
-                &kept)) {
+                std::max(2, min_run / 4), &kept)) {
           ++st.rejected_floating;
           std::vector<std::vector<cv::Point>> rest;
           cv::findContours(kept, rest, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, window.tl());
