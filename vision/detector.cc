@@ -650,6 +650,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.solid; });
     const bool none_round =
         std::none_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
+    const bool all_round =
+        std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
     std::vector<std::vector<cv::Point>> blobs;
     // OpenCV 4 leaves the image unchanged: no copy of the mask.
@@ -738,8 +740,6 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           continue;
         }
       }
-      const bool all_round =
-          std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
       // Touching objects: one piece each. A blob that fills its convex hull is one object
       // (two balls overlapping by 45 % of a diameter still fill only 97.8 %).
