@@ -11,6 +11,7 @@
 
 #include "vision/circle_fit.h"
 #include "vision/contour_fill.h"
+#include "vision/contour_trace.h"
 #include "vision/field_gate.h"
 
 namespace slamo::vision {
@@ -654,8 +655,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
     std::vector<std::vector<cv::Point>> blobs;
-    // OpenCV 4 leaves the image unchanged: no copy of the mask.
-    cv::findContours(masks[j], blobs, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    FindOuterContours(masks[j], &blobs);  // leaves the mask as it is: no copy of it
     // Blobs found in the mask; what is left of one after its floating part is cleared is
     // appended, and not tested again.
     const size_t found_blobs = blobs.size();
@@ -735,7 +735,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                 std::max(2, min_run / 4), &kept)) {
           ++st.rejected_floating;
           std::vector<std::vector<cv::Point>> rest;
-          cv::findContours(kept, rest, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, window.tl());
+          FindOuterContours(kept, &rest, window.tl());
           for (std::vector<cv::Point>& r : rest) blobs.push_back(std::move(r));  // `blob` dangles
           continue;
         }

@@ -12,6 +12,7 @@
 
 #include "platform/drive_base.h"
 #include "vision/contour_fill.h"
+#include "vision/contour_trace.h"
 
 namespace slamo::vision {
 namespace {
@@ -60,7 +61,7 @@ cv::Mat Binarize(const cv::Mat& mask) {
 
 std::vector<Contour> ExternalContours(const cv::Mat& binary) {
   std::vector<Contour> contours;
-  cv::findContours(binary, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  FindOuterContours(binary, &contours);
   return contours;
 }
 

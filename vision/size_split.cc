@@ -8,6 +8,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/contour_trace.h"
+
 namespace slamo::vision {
 namespace {
 
@@ -278,7 +280,7 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
     cv::dilate(g, g, grow);
     g &= mask;
     std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(g, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    FindOuterContours(g, &contours);
     if (contours.empty()) continue;
     const auto largest = std::max_element(
         contours.begin(), contours.end(),
