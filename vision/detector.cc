@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/area_resize.h"
 #include "vision/circle_fit.h"
 #include "vision/contour_fill.h"
 #include "vision/contour_trace.h"
@@ -790,7 +791,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         const double scale =
             std::sqrt(static_cast<double>(options.separation_max_pixels) / blob_mask.total());
         cv::Mat small;
-        cv::resize(blob_mask, small, cv::Size(), scale, scale, cv::INTER_AREA);
+        ResizeAreaLike(blob_mask, scale, &small);  // cv::resize(INTER_AREA), byte for byte
         cv::threshold(small, small, 127, 255, cv::THRESH_BINARY);
         separated = SeparateTouching(small, options.separation, options.separation_options);
         for (std::vector<cv::Point>& piece : separated.pieces) {
