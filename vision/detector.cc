@@ -14,6 +14,7 @@
 #include "vision/contour_fill.h"
 #include "vision/contour_trace.h"
 #include "vision/field_gate.h"
+#include "vision/span_morphology.h"
 
 namespace slamo::vision {
 namespace {
@@ -98,76 +99,11 @@ double ConvexHullArea(const std::vector<cv::Point>& outline, const cv::Rect& box
   return std::abs(static_cast<double>(twice_area)) * 0.5;
 }
 
-// Morphology of an 8-bit mask with a kernel whose rows are each one run of ones centred on
-// the anchor column (an ellipse), exactly as cv::dilate / cv::erode with their default
-// border (pixels beyond the image take no part): each kernel row is a horizontal max (min)
-// over its half-width, and the rows are combined by a vertical max (min). The same maxima
-// (minima) of the same pixels, with a few passes per row instead of one per kernel element.
-// False (nothing done) for any other kernel.
-template <bool kDilate>
-bool SpanMorphology(const cv::Mat& src, const cv::Mat& kernel, cv::Mat* dst) {
-  if (src.type() != CV_8UC1 || kernel.type() != CV_8UC1 || kernel.cols % 2 == 0) return false;
-  const int centre = kernel.cols / 2, anchor_row = kernel.rows / 2;
-  std::vector<int> half(kernel.rows, -1);  // per kernel row: half-width, -1 if empty
-  for (int i = 0; i < kernel.rows; ++i) {
-    const uint8_t* k = kernel.ptr<uint8_t>(i);
-    int first = -1, last = -1;
-    for (int j = 0; j < kernel.cols; ++j) {
-      if (k[j]) {
-        if (first < 0) first = j;
-        if (last >= 0 && last != j - 1) return false;  // not one run
-        last = j;
-      }
-    }
-    if (first < 0) continue;
-    if (centre - first != last - centre) return false;  // not centred
-    half[i] = centre - first;
-  }
-  const int rows = src.rows, cols = src.cols;
-  const auto op = [](uint8_t a, uint8_t b) -> uint8_t {
-    return kDilate ? std::max(a, b) : std::min(a, b);
-  };
-  const int widest = *std::max_element(half.begin(), half.end());
-  // horizontal[w]: each row's max (min) over [x - w, x + w] (within the row).
-  thread_local std::vector<std::vector<uint8_t>> horizontal;
-  if (static_cast<int>(horizontal.size()) < widest + 1) horizontal.resize(widest + 1);
-  for (int w = 0; w <= widest; ++w) horizontal[w].resize(static_cast<size_t>(rows) * cols);
-  for (int y = 0; y < rows; ++y) std::copy_n(src.ptr<uint8_t>(y), cols, &horizontal[0][y * cols]);
-  for (int w = 1; w <= widest; ++w) {
-    for (int y = 0; y < rows; ++y) {
-      const uint8_t* in = &horizontal[w - 1][y * cols];
-      uint8_t* out = &horizontal[w][y * cols];
-      if (cols == 1) {
-        out[0] = in[0];
-        continue;
-      }
-      out[0] = op(in[0], in[1]);
-      for (int x = 1; x + 1 < cols; ++x) out[x] = op(op(in[x - 1], in[x]), in[x + 1]);
-      out[cols - 1] = op(in[cols - 2], in[cols - 1]);
-    }
-  }
-  cv::Mat out(rows, cols, CV_8UC1, cv::Scalar(kDilate ? 0 : 255));
-  for (int y = 0; y < rows; ++y) {
-    uint8_t* o = out.ptr<uint8_t>(y);
-    for (int i = 0; i < kernel.rows; ++i) {
-      const int from = y + i - anchor_row;
-      if (half[i] < 0 || from < 0 || from >= rows) continue;
-      const uint8_t* in = &horizontal[half[i]][from * cols];
-      for (int x = 0; x < cols; ++x) o[x] = op(o[x], in[x]);
-    }
-  }
-  *dst = out;
-  return true;
-}
-
-// cv::morphologyEx(MORPH_CLOSE) of a binary mask, by SpanMorphology when the kernel allows.
+// cv::morphologyEx(MORPH_CLOSE) of a binary mask.
 void CloseBinary(cv::Mat* mask, const cv::Mat& kernel) {
   cv::Mat dilated;
-  if (SpanMorphology<true>(*mask, kernel, &dilated) &&
-      SpanMorphology<false>(dilated, kernel, mask)) {
-    return;
-  }
-  cv::morphologyEx(*mask, *mask, cv::MORPH_CLOSE, kernel);
+  DilateLike(*mask, kernel, &dilated);
+  ErodeLike(dilated, kernel, mask);
 }
 
 // A circle fitted (algebraic least squares, Kasa) to outline points.
@@ -818,7 +754,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       if (all_round && !whole && !by_size) {
         outline = cv::Mat(window.size(), CV_8UC1, cv::Scalar(0));
         for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
-        cv::dilate(outline, outline, cv::Mat());  // 3x3: a piece's outline may shift by a pixel
+        DilateLike(outline, cv::Mat(), &outline);  // 3x3: a piece's outline may shift by a pixel
       }
       for (std::vector<cv::Point> piece : separated.pieces) {
         ++st.pieces;

@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/span_morphology.h"
+
 namespace slamo::vision {
 
 Eigen::Vector2d RangeBearing(const CameraModel& camera, double u, double v, double z_m) {
@@ -75,9 +77,10 @@ std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv:
   cv::Mat inner = blob_mask;
   if (options.erode_px > 0) {
     cv::Mat eroded;
-    cv::erode(blob_mask, eroded,
+    ErodeLike(blob_mask,
               cv::getStructuringElement(
-                  cv::MORPH_ELLIPSE, cv::Size(2 * options.erode_px + 1, 2 * options.erode_px + 1)));
+                  cv::MORPH_ELLIPSE, cv::Size(2 * options.erode_px + 1, 2 * options.erode_px + 1)),
+              &eroded);
     if (cv::countNonZero(eroded) >= options.min_depth_pixels) inner = eroded;
   }
   const cv::Rect box = cv::boundingRect(inner);
