@@ -876,6 +876,17 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                 ++st.rejected_flat;
                 continue;
               }
+              if (options.flat_curvature_ratio > 0.0) {
+                const std::optional<LeastCurvature> least = MeasureLeastCurvature(
+                    depth_roi, piece_mask, roi.tl(), *setup.camera, surface->depth_m,
+                    best->radius_m, options.measurement.erode_px);
+                if (least &&
+                    std::abs(least->curvature) + options.flat_curvature_sigmas * least->sigma <
+                        options.flat_curvature_ratio / best->radius_m) {
+                  ++st.rejected_flat;
+                  continue;
+                }
+              }
             }
             d.kind = best->name;
             d.measurement = MeasureFromSurface(*surface, d.centre_px, best->surface_to_centre_m,

@@ -57,6 +57,15 @@ struct DetectOptions {
   // the kind's radius. A sphere's is about 0.28; a triball's least, a face turned to the
   // camera (a sphere of its width), about 0.12. 0 turns the test off.
   double min_bulge_ratio = 0.1;
+  // ... and must curve in every direction, not only across one (MeasureLeastCurvature): a
+  // piece whose least curvature, in either sign, plus flat_curvature_sigmas of its depth-noise
+  // sigma, stays under flat_curvature_ratio / the kind's radius is flat along some direction
+  // (a bumper's noodle or box edge running any way in the image, which the bulge test's row
+  // and column bands miss when it runs diagonally) and is dropped. A sphere gives about 1,
+  // a triball's face turned to the camera (a sphere of its width) about 0.5. A piece curving
+  // the wrong way more than that (the valley of two balls a cut missed) is kept. 0: off.
+  double flat_curvature_ratio = 0.3;
+  double flat_curvature_sigmas = 2.0;
   // With depth, for colours of solid kinds with flat bases (no round kind: rings, cubes,
   // blocks, goals): the part of a blob held off the floor over nothing is cleared (a robot's
   // bumper, alone or touching an object). A column floats when the farthest of the

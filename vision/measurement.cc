@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
 #include "vision/span_morphology.h"
@@ -22,6 +23,84 @@ std::optional<Measurement> MeasureBlob(const cv::Mat& depth_mm, const cv::Mat& b
       MeasureBlobSurface(depth_mm, blob_mask, camera, options);
   if (!surface) return std::nullopt;
   return MeasureFromSurface(*surface, centre_px, surface_to_centre_m, radius_px, camera, options);
+}
+
+std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, const cv::Mat& mask,
+                                                    cv::Point offset, const CameraModel& camera,
+                                                    double depth_m, double band_m, int erode_px,
+                                                    int min_readings) {
+  if (depth_mm.empty() || depth_mm.type() != CV_16UC1 || mask.size() != depth_mm.size()) {
+    return std::nullopt;
+  }
+  cv::Mat inner = mask;
+  if (erode_px > 0) {
+    ErodeLike(
+        mask,
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * erode_px + 1, 2 * erode_px + 1)),
+        &inner);
+  }
+  // One pass: the sums of the monomials the normal equations need, in metres about the
+  // mask's middle at depth_m (well conditioned at any range).
+  const field::CameraConfig& c = camera.config();
+  const double u0 = offset.x + 0.5 * (inner.cols - 1), v0 = offset.y + 0.5 * (inner.rows - 1);
+  const double near_m = depth_m - band_m, far_m = depth_m + band_m;
+  double m[5][5] = {};  // m[i][j]: sum of x^i y^j, i + j <= 4
+  double w[3][3] = {};  // w[i][j]: sum of (z - depth_m) x^i y^j, i + j <= 2
+  int count = 0;
+  // Every other row and column of a piece of more than 400 pixels: a quadric needs no more,
+  // and the sigma below grows with fewer readings (on the detector benchmark's view this
+  // costs 0.05 ms a frame, all of them 0.11 ms).
+  const int step = cv::countNonZero(inner) > 400 ? 2 : 1;
+  // CorrectDepthM, z = (raw - b) / a / 1000, as one multiply-add per reading.
+  const double m_per_raw = 0.001 / c.depth_correction.a;
+  const double m_at_zero = -c.depth_correction.b_mm * m_per_raw;
+  const double inv_fx = 1.0 / c.fx, inv_fy = 1.0 / c.fy;
+  for (int v = 0; v < inner.rows; v += step) {
+    const uint8_t* mv = inner.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    const double row_y = (v + offset.y - v0) * inv_fy;
+    for (int u = 0; u < inner.cols; u += step) {
+      if (!mv[u] || !d[u]) continue;
+      const double z = d[u] * m_per_raw + m_at_zero;
+      if (!(z > 0.0) || z < near_m || z > far_m) continue;
+      const double x = (u + offset.x - u0) * inv_fx * z, y = row_y * z;
+      const double dz = z - depth_m;
+      const double xx = x * x, xy = x * y, yy = y * y;
+      m[0][0] += 1.0, m[1][0] += x, m[0][1] += y;
+      m[2][0] += xx, m[1][1] += xy, m[0][2] += yy;
+      m[3][0] += xx * x, m[2][1] += xx * y, m[1][2] += x * yy, m[0][3] += yy * y;
+      m[4][0] += xx * xx, m[3][1] += xx * xy, m[2][2] += xx * yy, m[1][3] += xy * yy,
+          m[0][4] += yy * yy;
+      w[0][0] += dz, w[1][0] += dz * x, w[0][1] += dz * y;
+      w[2][0] += dz * xx, w[1][1] += dz * xy, w[0][2] += dz * yy;
+      ++count;
+    }
+  }
+  if (count < min_readings) return std::nullopt;
+  // Basis 1, x, y, x^2, xy, y^2 as exponents (i, j).
+  constexpr int kI[6] = {0, 1, 0, 2, 1, 0}, kJ[6] = {0, 0, 1, 0, 1, 2};
+  Eigen::Matrix<double, 6, 6> normal;
+  Eigen::Matrix<double, 6, 1> rhs;
+  for (int a = 0; a < 6; ++a) {
+    for (int b = 0; b < 6; ++b) normal(a, b) = m[kI[a] + kI[b]][kJ[a] + kJ[b]];
+    rhs(a) = w[kI[a]][kJ[a]];
+  }
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
+  if (solver.info() != Eigen::Success || !solver.isPositive()) return std::nullopt;
+  const Eigen::Matrix<double, 6, 1> q = solver.solve(rhs);
+  Eigen::Matrix2d hessian;
+  hessian << 2.0 * q(3), q(4), q(4), 2.0 * q(5);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(hessian);
+  // Its uncertainty from the camera's depth noise (the robot file's model) at this depth,
+  // through the fit's covariance, along the least curved direction v (d lambda = v' dH v).
+  const double noise = camera.DepthSigmaM(depth_m);
+  const Eigen::Vector2d v = eigen.eigenvectors().col(0);
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  g(3) = 2.0 * v.x() * v.x();
+  g(4) = 2.0 * v.x() * v.y();
+  g(5) = 2.0 * v.y() * v.y();
+  const double variance = noise * noise * g.dot(solver.solve(g));
+  return LeastCurvature{eigen.eigenvalues()(0), std::sqrt(std::max(0.0, variance))};
 }
 
 uint16_t MedianReading(const std::vector<uint16_t>& readings) {

@@ -75,6 +75,25 @@ std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const c
                                                 const CameraModel& camera,
                                                 bool along_columns = false);
 
+// How the surface under a mask curves where it curves least: a quadric z = a + bx + cy +
+// dx^2 + exy + fy^2 fitted by least squares to its readings (x, y, z in metres in the camera
+// frame; `offset`: the mask's top-left pixel in the image; the mask eroded by `erode_px`
+// first so that the rim's mixed readings stay out; readings farther than `band_m` from
+// `depth_m`, the piece's own depth, left out as another object seen beside it), and the
+// smaller eigenvalue of its Hessian, in 1/m. A sphere of radius R facing the camera gives
+// about 1/R; a cylinder (a bumper's noodle) or the edge where two faces of a box meet, about
+// 0 along it, whichever way it runs in the image; a plane, 0; the valley between two balls,
+// less than 0. `sigma`: its standard deviation from the camera's depth noise. nullopt with
+// fewer than `min_readings` readings.
+struct LeastCurvature {
+  double curvature = 0.0;  // 1/m
+  double sigma = 0.0;      // 1/m
+};
+std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, const cv::Mat& mask,
+                                                    cv::Point offset, const CameraModel& camera,
+                                                    double depth_m, double band_m, int erode_px = 2,
+                                                    int min_readings = 20);
+
 // The median of depth readings as std::nth_element gives it (the element of rank size / 2),
 // by a two-pass radix count instead of partial sorting. `readings` must not be empty.
 uint16_t MedianReading(const std::vector<uint16_t>& readings);

@@ -28,6 +28,7 @@ struct EvalArgs {
   std::vector<int> pile;  // MIN,MAX
   bool no_size_split = false;
   bool no_bulge_test = false;
+  bool no_curvature_test = false;
   bool no_float_test = false;
 };
 
@@ -45,6 +46,7 @@ int RunVision(const EvalArgs& args) {
   options.pose_sigma_m = args.pose_sigma_m;
   options.detect.split_by_size = !args.no_size_split;
   if (args.no_bulge_test) options.detect.min_bulge_ratio = 0.0;
+  if (args.no_curvature_test) options.detect.flat_curvature_ratio = 0.0;
   options.detect.drop_floating = !args.no_float_test;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
@@ -113,6 +115,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   vision->add_flag("--no-bulge-test", args->no_bulge_test,
                    "keep round detections whose surface does not curve away (the detector "
                    "before the test, for comparison)");
+  vision->add_flag("--no-curvature-test", args->no_curvature_test,
+                   "keep round detections flat along some direction (the detector before the "
+                   "test, for comparison)");
   vision->add_flag("--no-float-test", args->no_float_test,
                    "keep blobs held off the floor over nothing (the detector before the test, "
                    "for comparison)");

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <cmath>
 #include <map>
 #include <set>
@@ -246,6 +248,22 @@ TEST(SizeSplitTest, ABlobOffTheFloorIsNotSplitBySize) {
   }
 }
 
+// A lone green triball `range_m` ahead of the thesis camera, rendered with its noise, and the
+// pixels it covers.
+platform::RgbdFrame RenderedTriball(const field::SeasonConfig& season,
+                                    const field::RobotConfig& robot, double range_m,
+                                    cv::Mat* mask) {
+  platform::SimWorld world = platform::CreateWorld(season, 1);
+  world.objects.clear();
+  const std::vector<int> ids =
+      platform::AddStack(*season.FindObjectType("triball"), "green", kSpot, 1, &world);
+  platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 1);
+  platform::FrameTruth truth;
+  platform::RgbdFrame frame = renderer.Render(world, Facing(kSpot, range_m), 0.0, &truth);
+  *mask = truth.ids == ids.front();
+  return frame;
+}
+
 // The bulge test of round kinds (vision/measurement.h MeasureSurfaceBulge), on rendered depth
 // with the thesis camera's noise: a ball's surface curves away from the camera by about 0.28
 // of its radius between the centre and the rim bands; a flat face (the perimeter wall, seen
@@ -257,13 +275,8 @@ TEST(SurfaceBulgeTest, ABallCurvesAwayAndAWallDoesNot) {
   const field::ObjectType& triball = *season.FindObjectType("triball");
   const double radius_m = triball.size_m / 2.0;
   for (double range : {0.8, 1.5, 2.5}) {
-    platform::SimWorld world = platform::CreateWorld(season, 1);
-    world.objects.clear();
-    const std::vector<int> ids = platform::AddStack(triball, "green", kSpot, 1, &world);
-    platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 1);
-    platform::FrameTruth truth;
-    const platform::RgbdFrame frame = renderer.Render(world, Facing(kSpot, range), 0.0, &truth);
-    const cv::Mat mask = truth.ids == ids.front();
+    cv::Mat mask;
+    const platform::RgbdFrame frame = RenderedTriball(season, robot, range, &mask);
     const cv::Moments m = cv::moments(mask, true);
     ASSERT_GT(m.m00, 40.0);
     const cv::Point2d centre(m.m10 / m.m00, m.m01 / m.m00);
@@ -345,6 +358,91 @@ TEST(SurfaceBulgeTest, ABoxEdgeCurvesOneWayOnly) {
     EXPECT_GT(curved.bulge_m - 3.0 * curved.sigma_m, 0.1 * radius_m);
     EXPECT_LT(std::abs(straight.bulge_m) + 3.0 * straight.sigma_m, 0.1 * radius_m);
   }
+}
+
+// The least curvature (vision/measurement.h MeasureLeastCurvature): a rendered triball, with
+// the thesis camera's noise, curves about as a sphere of its radius would, well clear of the
+// detector's 0.3 / R; the edge of a box and a bumper's noodle (a cylinder of 3 cm), running
+// any way across the image, are flat along their length, also at 45 degrees, where the bulge
+// test's row and column bands both see them curve; the valley between two balls curves the
+// other way.
+TEST(SurfaceCurvatureTest, ABallCurvesEveryWayAnEdgeAndANoodleDoNot) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("over_under");
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  const CameraModel camera(robot.camera);
+  const field::ObjectType& triball = *season.FindObjectType("triball");
+  const double radius_m = triball.size_m / 2.0;
+  for (double range : {0.8, 1.5, 2.5}) {
+    cv::Mat mask;
+    const platform::RgbdFrame frame = RenderedTriball(season, robot, range, &mask);
+    SCOPED_TRACE("ball at " + std::to_string(range) + " m");
+    const std::optional<BlobSurface> surface =
+        MeasureBlobSurface(frame.depth_mm, mask, camera, MeasurementOptions{});
+    ASSERT_TRUE(surface.has_value());
+    const std::optional<LeastCurvature> least = MeasureLeastCurvature(
+        frame.depth_mm, mask, cv::Point(), camera, surface->depth_m, radius_m);
+    ASSERT_TRUE(least.has_value());
+    EXPECT_NEAR(least->curvature * radius_m, 1.0, 0.5);
+    EXPECT_GT(least->curvature - 2.0 * least->sigma, 0.3 / radius_m);
+  }
+  // Surfaces drawn exactly (raw readings through the camera's depth correction), 1 m ahead,
+  // through the centre's ray; s: the distance across the edge (or the noodle's axis) at unit
+  // depth, the edge turned `turn_deg` in the image.
+  const int cols = robot.camera.width_px, rows = robot.camera.height_px;
+  const double radius_px = 40.0;
+  const cv::Point2d centre(cols / 2.0, rows / 2.0);
+  cv::Mat mask(rows, cols, CV_8UC1, cv::Scalar(0));
+  cv::circle(mask, centre, static_cast<int>(radius_px), cv::Scalar(255), cv::FILLED);
+  const Eigen::Vector3d c = camera.BackProject(centre.x, centre.y, 1.0);
+  const auto draw = [&](const std::function<double(double)>& depth_across, double turn_deg) {
+    const double a = turn_deg * M_PI / 180.0;
+    cv::Mat depth(rows, cols, CV_16UC1, cv::Scalar(0));
+    for (int v = 0; v < rows; ++v) {
+      for (int u = 0; u < cols; ++u) {
+        const Eigen::Vector3d ray = camera.BackProject(u, v, 1.0);
+        const double s = -(ray.x() - c.x()) * std::sin(a) + (ray.y() - c.y()) * std::cos(a);
+        depth.at<uint16_t>(v, u) = static_cast<uint16_t>(
+            std::lround(robot.camera.depth_correction.a * depth_across(s) * 1000.0 +
+                        robot.camera.depth_correction.b_mm));
+      }
+    }
+    return depth;
+  };
+  const auto edge = [](double s) { return 1.0 / (1.0 - std::abs(s)); };
+  const double noodle_m = 0.03;
+  const auto noodle = [&](double s) {
+    const double x = std::min(std::abs(s), noodle_m);  // on the cylinder, 1 m to its front
+    return 1.0 + noodle_m - std::sqrt(noodle_m * noodle_m - x * x);
+  };
+  for (double turn_deg : {0.0, 30.0, 45.0, 70.0, 90.0}) {
+    for (bool is_edge : {true, false}) {
+      SCOPED_TRACE(std::string(is_edge ? "edge" : "noodle") + " turned " +
+                   std::to_string(turn_deg) + " deg");
+      const cv::Mat depth = draw(is_edge ? std::function<double(double)>(edge) : noodle, turn_deg);
+      const std::optional<LeastCurvature> least =
+          MeasureLeastCurvature(depth, mask, cv::Point(), camera, 1.0, radius_m);
+      ASSERT_TRUE(least.has_value());
+      EXPECT_LT(std::abs(least->curvature) + 2.0 * least->sigma, 0.3 / radius_m);
+      if (is_edge && turn_deg == 45.0) {  // the bulge test sees it curve both ways
+        for (bool along_columns : {false, true}) {
+          const std::optional<SurfaceBulge> bulge =
+              MeasureSurfaceBulge(depth, mask, centre, radius_px, camera, along_columns);
+          ASSERT_TRUE(bulge.has_value());
+          EXPECT_GT(bulge->bulge_m - 3.0 * bulge->sigma_m, 0.1 * radius_m);
+        }
+      }
+    }
+  }
+  // Two balls side by side, the mask across both: the valley between them.
+  const double ball_m = radius_m;
+  const auto two_balls = [&](double s) {
+    const double x = std::min(std::abs(std::abs(s) - ball_m), ball_m);  // each ball's own offset
+    return 1.0 + ball_m - std::sqrt(ball_m * ball_m - x * x);
+  };
+  const std::optional<LeastCurvature> valley =
+      MeasureLeastCurvature(draw(two_balls, 90.0), mask, cv::Point(), camera, 1.0, 2.0 * radius_m);
+  ASSERT_TRUE(valley.has_value());
+  EXPECT_LT(valley->curvature, -0.3 / radius_m);
 }
 
 // The split alone: an empty or depthless blob gives no groups; one object, one group.
