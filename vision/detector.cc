@@ -592,7 +592,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
     std::vector<std::vector<cv::Point>> blobs;
-    FindOuterContours(masks[j], &blobs);  // leaves the mask as it is: no copy of it
+    FindOuterContours(masks[j], &blobs);  // leaves the mask as it is
     // Blobs found in the mask; what is left of one after its floating part is cleared is
     // appended, and not tested again.
     const size_t found_blobs = blobs.size();

@@ -58,12 +58,12 @@ struct DetectOptions {
   // camera (a sphere of its width), about 0.12. 0 turns the test off.
   double min_bulge_ratio = 0.1;
   // ... and must curve in every direction, not only across one (MeasureLeastCurvature): a
-  // piece whose least curvature, in either sign, plus flat_curvature_sigmas of its depth-noise
-  // sigma, stays under flat_curvature_ratio / the kind's radius is flat along some direction
-  // (a bumper's noodle or box edge running any way in the image, which the bulge test's row
-  // and column bands miss when it runs diagonally) and is dropped. A sphere gives about 1,
-  // a triball's face turned to the camera (a sphere of its width) about 0.5. A piece curving
-  // the wrong way more than that (the valley of two balls a cut missed) is kept. 0: off.
+  // piece whose curvature nearest zero, in either sign, plus flat_curvature_sigmas of its
+  // depth-noise sigma, stays under flat_curvature_ratio / the kind's radius is flat along some
+  // direction (a bumper's noodle or a box edge, convex or concave, running any way in the
+  // image, which the bulge test's row and column bands miss when it runs diagonally) and is
+  // dropped. A sphere gives about 1, a triball's face turned to the camera (a sphere of its
+  // width) about 0.5. 0: off.
   double flat_curvature_ratio = 0.3;
   double flat_curvature_sigmas = 2.0;
   // With depth, for colours of solid kinds with flat bases (no round kind: rings, cubes,

@@ -32,17 +32,21 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
   if (depth_mm.empty() || depth_mm.type() != CV_16UC1 || mask.size() != depth_mm.size()) {
     return std::nullopt;
   }
-  cv::Mat inner = mask;
+  cv::Mat inner;  // its own pixels: the caller's mask is left as it is
   if (erode_px > 0) {
     ErodeLike(
         mask,
         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * erode_px + 1, 2 * erode_px + 1)),
         &inner);
+  } else {
+    inner = mask;
   }
   // One pass: the sums of the monomials the normal equations need, in metres about the
-  // mask's middle at depth_m (well conditioned at any range).
+  // mask's centre at depth_m.
   const field::CameraConfig& c = camera.config();
-  const double u0 = offset.x + 0.5 * (inner.cols - 1), v0 = offset.y + 0.5 * (inner.rows - 1);
+  const cv::Moments pixels = cv::moments(inner, /*binaryImage=*/true);
+  if (pixels.m00 < min_readings) return std::nullopt;
+  const double u0 = offset.x + pixels.m10 / pixels.m00, v0 = offset.y + pixels.m01 / pixels.m00;
   const double near_m = depth_m - band_m, far_m = depth_m + band_m;
   double m[5][5] = {};  // m[i][j]: sum of x^i y^j, i + j <= 4
   double w[3][3] = {};  // w[i][j]: sum of (z - depth_m) x^i y^j, i + j <= 2
@@ -50,7 +54,7 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
   // Every other row and column of a piece of more than 400 pixels: a quadric needs no more,
   // and the sigma below grows with fewer readings (on the detector benchmark's view this
   // costs 0.05 ms a frame, all of them 0.11 ms).
-  const int step = cv::countNonZero(inner) > 400 ? 2 : 1;
+  const int step = pixels.m00 > 400 ? 2 : 1;
   // CorrectDepthM, z = (raw - b) / a / 1000, as one multiply-add per reading.
   const double m_per_raw = 0.001 / c.depth_correction.a;
   const double m_at_zero = -c.depth_correction.b_mm * m_per_raw;
@@ -85,22 +89,37 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
     for (int b = 0; b < 6; ++b) normal(a, b) = m[kI[a] + kI[b]][kJ[a] + kJ[b]];
     rhs(a) = w[kI[a]][kJ[a]];
   }
-  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
-  if (solver.info() != Eigen::Success || !solver.isPositive()) return std::nullopt;
-  const Eigen::Matrix<double, 6, 1> q = solver.solve(rhs);
+  // Solved on coordinates scaled to the piece's size, where every basis function is of order
+  // one: a piece whose readings do not spread both ways (a strip, a line) leaves a pivot near
+  // zero, and its curvature along the missing direction is not known.
+  const double spread =
+      std::sqrt(std::max(1e-12, (m[2][0] + m[0][2]) / m[0][0] -
+                                    (m[1][0] * m[1][0] + m[0][1] * m[0][1]) / (m[0][0] * m[0][0])));
+  Eigen::Matrix<double, 6, 1> scale;
+  for (int a = 0; a < 6; ++a) scale(a) = std::pow(spread, -(kI[a] + kJ[a]));
+  const Eigen::Matrix<double, 6, 6> scaled = scale.asDiagonal() * normal * scale.asDiagonal();
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(scaled);
+  if (solver.info() != Eigen::Success) return std::nullopt;
+  const Eigen::VectorXd pivots = solver.vectorD().cwiseAbs();
+  if (!(pivots.minCoeff() > 1e-6 * pivots.maxCoeff())) return std::nullopt;
+  const Eigen::Matrix<double, 6, 1> q = scale.asDiagonal() * solver.solve(scale.asDiagonal() * rhs);
   Eigen::Matrix2d hessian;
   hessian << 2.0 * q(3), q(4), q(4), 2.0 * q(5);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(hessian);
+  // The curvature nearest zero (a ball: both about 1/R; an edge or a noodle, convex or
+  // concave: about 0 along it).
+  const int least = std::abs(eigen.eigenvalues()(0)) <= std::abs(eigen.eigenvalues()(1)) ? 0 : 1;
   // Its uncertainty from the camera's depth noise (the robot file's model) at this depth,
-  // through the fit's covariance, along the least curved direction v (d lambda = v' dH v).
+  // through the fit's covariance, along that direction v (d lambda = v' dH v).
   const double noise = camera.DepthSigmaM(depth_m);
-  const Eigen::Vector2d v = eigen.eigenvectors().col(0);
+  const Eigen::Vector2d v = eigen.eigenvectors().col(least);
   Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
   g(3) = 2.0 * v.x() * v.x();
   g(4) = 2.0 * v.x() * v.y();
   g(5) = 2.0 * v.y() * v.y();
-  const double variance = noise * noise * g.dot(solver.solve(g));
-  return LeastCurvature{eigen.eigenvalues()(0), std::sqrt(std::max(0.0, variance))};
+  const Eigen::Matrix<double, 6, 1> gs = scale.asDiagonal() * g;
+  const double variance = noise * noise * gs.dot(solver.solve(gs));
+  return LeastCurvature{eigen.eigenvalues()(least), std::sqrt(std::max(0.0, variance))};
 }
 
 uint16_t MedianReading(const std::vector<uint16_t>& readings) {

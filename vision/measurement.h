@@ -77,14 +77,16 @@ std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const c
 
 // How the surface under a mask curves where it curves least: a quadric z = a + bx + cy +
 // dx^2 + exy + fy^2 fitted by least squares to its readings (x, y, z in metres in the camera
-// frame; `offset`: the mask's top-left pixel in the image; the mask eroded by `erode_px`
-// first so that the rim's mixed readings stay out; readings farther than `band_m` from
-// `depth_m`, the piece's own depth, left out as another object seen beside it), and the
-// smaller eigenvalue of its Hessian, in 1/m. A sphere of radius R facing the camera gives
-// about 1/R; a cylinder (a bumper's noodle) or the edge where two faces of a box meet, about
-// 0 along it, whichever way it runs in the image; a plane, 0; the valley between two balls,
-// less than 0. `sigma`: its standard deviation from the camera's depth noise. nullopt with
-// fewer than `min_readings` readings.
+// frame about the mask's centre; `offset`: the mask's top-left pixel in the image; the mask
+// eroded by `erode_px` first so that the rim's mixed readings stay out, the caller's mask left
+// as it is; readings farther than `band_m` from `depth_m`, the piece's own depth, left out as
+// another object seen beside it), and the eigenvalue of its Hessian nearest zero, in 1/m. A
+// sphere of radius R facing the camera gives about 1/R; a cylinder (a bumper's noodle) or the
+// edge where two faces of a box meet, convex or concave, about 0 along it, whichever way it
+// runs in the image; a plane, 0. `sigma`: its standard deviation from the camera's depth
+// noise (along one eigenvector: where both are equal, a ball's, noise pulls the smaller one
+// down a little more than it says). nullopt with fewer than `min_readings` readings, or when
+// they do not spread both ways (a strip).
 struct LeastCurvature {
   double curvature = 0.0;  // 1/m
   double sigma = 0.0;      // 1/m

@@ -73,7 +73,7 @@ TEST(ContourTraceTest, SameAsFindContours) {
 }
 
 TEST(ContourTraceTest, EdgeCases) {
-  Outlines traced;
+  Outlines traced = {{cv::Point(1, 1)}};  // replaced, not appended to
   // Empty, all background, all foreground, one pixel, one row, one column.
   FindOuterContours(cv::Mat(), &traced);
   EXPECT_TRUE(traced.empty());
