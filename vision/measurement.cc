@@ -42,11 +42,13 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
     inner = mask;
   }
   // One pass: the sums of the monomials the normal equations need, in metres about the
-  // mask's centre at depth_m.
+  // middle of the mask's pixels at depth_m.
   const field::CameraConfig& c = camera.config();
-  const cv::Moments pixels = cv::moments(inner, /*binaryImage=*/true);
-  if (pixels.m00 < min_readings) return std::nullopt;
-  const double u0 = offset.x + pixels.m10 / pixels.m00, v0 = offset.y + pixels.m01 / pixels.m00;
+  const int pixels = cv::countNonZero(inner);
+  if (pixels < min_readings) return std::nullopt;
+  const cv::Rect box = cv::boundingRect(inner);  // its middle: near enough the centroid
+  const double u0 = offset.x + box.x + 0.5 * (box.width - 1);
+  const double v0 = offset.y + box.y + 0.5 * (box.height - 1);
   const double near_m = depth_m - band_m, far_m = depth_m + band_m;
   double m[5][5] = {};  // m[i][j]: sum of x^i y^j, i + j <= 4
   double w[3][3] = {};  // w[i][j]: sum of (z - depth_m) x^i y^j, i + j <= 2
@@ -54,7 +56,7 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
   // Every other row and column of a piece of more than 400 pixels: a quadric needs no more,
   // and the sigma below grows with fewer readings (on the detector benchmark's view this
   // costs 0.05 ms a frame, all of them 0.11 ms).
-  const int step = pixels.m00 > 400 ? 2 : 1;
+  const int step = pixels > 400 ? 2 : 1;
   // CorrectDepthM, z = (raw - b) / a / 1000, as one multiply-add per reading.
   const double m_per_raw = 0.001 / c.depth_correction.a;
   const double m_at_zero = -c.depth_correction.b_mm * m_per_raw;
