@@ -122,7 +122,7 @@ TEST(VisionEvalTest, BumpersOffTheFloorAreNotTakenForRings) {
 // Round kinds must curve in every direction (DetectOptions::flat_curvature_ratio): pieces of
 // an opponent's bumper running diagonally in the image, which the bulge test's row and column
 // bands take for triballs, are dropped. Measured with `slamo eval vision --season over_under
-// --arena --frames 50 --seed 1 [--no-curvature-test]`: false detections on robots 159 -> 109
+// --arena --frames 50 --seed 1 [--no-curvature-test]`: false detections on robots 159 -> 103
 // over the six methods.
 TEST(VisionEvalTest, BumperPiecesFlatAlongTheirLengthAreNotTakenForTriballs) {
   VisionEvalOptions without;
