@@ -692,6 +692,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       std::optional<ObjectExtent> size_extent;
       if (options.split_by_size && blob_depth_m > 0.0) {
         size_extent = SizeExtentOf(kinds, options, &size_kind);
+        if (size_extent && all_round && !options.split_piles_by_size) size_extent.reset();
         if (size_extent && all_round) {
           const double metres_per_px = blob_depth_m / focal;
           const double object_area_m2 = M_PI * size_kind->radius_m * size_kind->radius_m;

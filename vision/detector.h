@@ -40,8 +40,10 @@ struct DetectOptions {
   double extent_margin_px = 2.0;
   // With depth, separation by the objects' known size (vision/size_split.h): for colours with
   // no round kind every blob (a ring is never cut, a stack of rings or blocks is split one by
-  // one); for round kinds of one size, piles: blobs larger than pile_area_ratio objects.
+  // one); for round kinds of one size, piles: blobs larger than pile_area_ratio objects
+  // (split_piles_by_size).
   bool split_by_size = true;
+  bool split_piles_by_size = true;
   double size_tolerance_horizontal = 1.25;  // a group fits one object up to this x its width
   double size_tolerance_vertical = 1.3;     // ... and this x its height
   double pile_area_ratio = 4.0;             // x the apparent area of one object

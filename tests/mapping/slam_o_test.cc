@@ -159,6 +159,45 @@ TEST_F(SlamOTest, ObjectsSeenTwiceAreMappedWhereTheyAre) {
   EXPECT_EQ(slam.ConfirmedObjects({taken}).size(), confirmed.size() - 1);
 }
 
+// Push Back's blocks lie in touching groups (three red ones in an L in front of the red
+// start). The match detector separates blobs of a colour with no round kind by the blocks' known
+// size: without it the group is one blob three blocks wide, rejected by size, and the planner
+// never knew the blocks nearest it (`slamo dry-run --season push_back --robot v5_drivetrain`).
+TEST(SlamOBlocksTest, ATouchingGroupOfBlocksIsTrackedBlockByBlock) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  const platform::SimWorld world = platform::CreateWorld(season, 3);
+  platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 3);
+  const platform::Pose2D start{-1.45, 0.6, 0.0};  // 0.85 m behind the group, facing it
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  SlamOPrior prior;
+  prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
+  prior.covariance = Eigen::Matrix3d::Identity() * 1e-6;
+  for (const Eigen::Vector3d& c : renderer.landmark_centres())
+    prior.surveyed_markers.push_back(c.head<2>());
+  SlamO slam(season, robot.camera, prior, options);
+  for (int k = 0; k < 3; ++k)
+    slam.TrackObjects(renderer.Render(world, start, k / 30.0, nullptr), k / 30.0);
+  // The group's blocks: red, on the floor, 0.5-1.1 m ahead of the robot (not the preloads).
+  std::vector<Eigen::Vector2d> group;
+  for (const platform::SimObject& t : world.objects) {
+    const Eigen::Vector2d rel = t.center_m.head<2>() - Eigen::Vector2d(start.x_m, start.y_m);
+    if (t.colour == "red" && t.center_m.z() < 0.1 && rel.x() > 0.5 && rel.norm() < 1.1)
+      group.push_back(t.center_m.head<2>());
+  }
+  ASSERT_EQ(group.size(), 3u);
+  std::vector<bool> found(group.size(), false);
+  for (const TrackedObject& o : slam.ConfirmedObjects()) {
+    if (o.colour != "red") continue;
+    for (size_t k = 0; k < group.size(); ++k) {
+      if ((group[k] - o.position_m).norm() < 0.05) found[k] = true;
+    }
+  }
+  for (size_t k = 0; k < group.size(); ++k)
+    EXPECT_TRUE(found[k]) << "block at " << group[k].transpose() << " not tracked";
+}
+
 TEST(OdometryIncrementTest, IsTheMoveInTheFirstPosesFrame) {
   const platform::Pose2D from{1.0, 2.0, kPi / 2};
   const platform::Pose2D to{1.0, 3.0, kPi};
