@@ -79,4 +79,10 @@ void ObjectTracker::Update(const Eigen::Vector3d& pose, const Eigen::Matrix3d& p
   }
 }
 
+int ObjectTracker::Forget(const std::function<bool(const TrackedObject&)>& gone) {
+  const size_t before = objects_.size();
+  objects_.erase(std::remove_if(objects_.begin(), objects_.end(), gone), objects_.end());
+  return static_cast<int>(before - objects_.size());
+}
+
 }  // namespace slamo::mapping

@@ -57,6 +57,9 @@ class ObjectTracker {
               const std::function<bool(const Eigen::Vector2d&)>& expected_visible = {});
 
   const std::vector<TrackedObject>& objects() const { return objects_; }
+  // Forgets the objects for which `gone` is true (e.g. believed where the robot now stands);
+  // returns how many.
+  int Forget(const std::function<bool(const TrackedObject&)>& gone);
   // Seen at least confirm_sightings times: a single sighting may be a false detection.
   bool Confirmed(const TrackedObject& object) const {
     return object.times_seen >= options_.confirm_sightings;

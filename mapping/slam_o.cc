@@ -218,6 +218,31 @@ void SlamO::UpdateMaps(const std::vector<int>& taken_ids,
   if (obstacles) obstacle_map_.SetObjects(blocking);
 }
 
+int SlamO::ForgetObjectsUnderRobot(double length_m, double width_m) {
+  const Eigen::Vector3d pose = ekf_.pose();
+  const Eigen::Matrix2d pose_xy = ekf_.pose_covariance().topLeftCorner<2, 2>();
+  const Eigen::Vector2d ahead(std::cos(pose.z()), std::sin(pose.z()));
+  const Eigen::Vector2d left(-ahead.y(), ahead.x());
+  const int forgotten = tracker_.Forget([&](const TrackedObject& o) {
+    // On something the robot does not drive over (or passes under): it may be up there.
+    for (const field::Structure& s : season_.structures) {
+      if ((s.blocks_robot || s.PassUnder()) &&
+          platform::DistanceToStructure(s, o.position_m) <= 0.0) {
+        return false;
+      }
+    }
+    for (const field::Goal& g : season_.goals) {
+      if (g.kind == field::GoalKind::kGoal && platform::GoalContains(g, o.position_m)) return false;
+    }
+    const double margin = 2.0 * std::sqrt((pose_xy + o.covariance).trace());
+    const Eigen::Vector2d rel = o.position_m - pose.head<2>();
+    return std::abs(rel.dot(ahead)) < length_m / 2.0 - margin &&
+           std::abs(rel.dot(left)) < width_m / 2.0 - margin;
+  });
+  forgotten_under_robot_ += forgotten;
+  return forgotten;
+}
+
 LandmarkFrame SlamO::Process(const platform::RgbdFrame& frame, const OdometryStep& u,
                              bool track_objects) {
   Predict(u);

@@ -137,6 +137,14 @@ class SlamO {
   LandmarkFrame Process(const platform::RgbdFrame& frame, const OdometryStep& u,
                         bool track_objects);
 
+  // 6. The robot of `length_m` x `width_m` stands at the estimated pose: objects on the floor
+  // believed under it are not there (it pushed them aside, or they never were), and are
+  // forgotten. Under means the object's centre inside the footprint shrunk by two standard
+  // deviations of the pose's and the object's position errors; objects within a goal's or a
+  // structure's footprint that the robot does not drive over are kept (they may be up on it).
+  // Returns how many were forgotten.
+  int ForgetObjectsUnderRobot(double length_m, double width_m);
+
   // What it believes.
   const EkfSlam& ekf() const { return ekf_; }
   Eigen::Vector3d pose() const { return ekf_.pose(); }
@@ -153,6 +161,7 @@ class SlamO {
   int gated_frames() const { return gated_frames_; }
   int relocalisations() const { return relocalisations_; }
   int rejected_by_geometry() const { return rejected_by_geometry_; }
+  int forgotten_under_robot() const { return forgotten_under_robot_; }
 
  private:
   std::vector<RangeBearing> MarkerMeasurements(const platform::RgbdFrame& frame) const;
@@ -177,6 +186,7 @@ class SlamO {
   int gated_frames_ = 0;
   int relocalisations_ = 0;
   int rejected_by_geometry_ = 0;
+  int forgotten_under_robot_ = 0;
 };
 
 }  // namespace slamo::mapping

@@ -300,6 +300,7 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   }
   slam_.Predict(u);
   odometry_ = now;
+  slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m);
   RecordSample();
   return std::all_of(results.begin(), results.end(), [](const platform::DriveStepResult& r) {
     return r.status == platform::DriveStepStatus::kDone;

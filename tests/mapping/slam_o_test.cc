@@ -198,6 +198,43 @@ TEST(SlamOBlocksTest, ATouchingGroupOfBlocksIsTrackedBlockByBlock) {
     EXPECT_TRUE(found[k]) << "block at " << group[k].transpose() << " not tracked";
 }
 
+// An object believed where the robot stands cannot be there: it is forgotten, unless it lies
+// on a structure. Objects beside the robot, or within the errors of the footprint's edge, stay.
+TEST_F(SlamOTest, ObjectsBelievedUnderTheRobotAreForgotten) {
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  SlamO slam(season_, robot_.camera, Prior(V(kObjectsView), Eigen::Matrix3d::Identity() * 1e-6),
+             options);
+  slam.TrackObjects(Render(kObjectsView, 0.0), 0.0);
+  slam.TrackObjects(Render(kObjectsView, 0.5), 0.5);
+  const std::vector<TrackedObject> confirmed = slam.ConfirmedObjects();
+  ASSERT_GE(confirmed.size(), 2u);
+  // The nearest object, in the robot's frame: a footprint just reaching it (within the
+  // errors of its edge) keeps it; one 0.1 m larger each way covers it, and nothing else.
+  const Eigen::Vector2d at(kObjectsView.x_m, kObjectsView.y_m);
+  const Eigen::Vector2d ahead(std::cos(kObjectsView.theta_rad), std::sin(kObjectsView.theta_rad));
+  const auto along = [&](const TrackedObject& o) {
+    return std::abs((o.position_m - at).dot(ahead));
+  };
+  const auto side = [&](const TrackedObject& o) {
+    const Eigen::Vector2d rel = o.position_m - at;
+    return std::abs(rel.x() * ahead.y() - rel.y() * ahead.x());
+  };
+  const TrackedObject nearest = *std::min_element(
+      confirmed.begin(), confirmed.end(), [&](const TrackedObject& a, const TrackedObject& b) {
+        return (a.position_m - at).norm() < (b.position_m - at).norm();
+      });
+  const double length = 2.0 * along(nearest), width = 2.0 * side(nearest);
+  for (const TrackedObject& o : confirmed) {
+    if (o.id == nearest.id) continue;
+    ASSERT_TRUE(along(o) > length / 2.0 + 0.1 || side(o) > width / 2.0 + 0.1);
+  }
+  EXPECT_EQ(slam.ForgetObjectsUnderRobot(length + 0.01, width + 0.01), 0);
+  EXPECT_EQ(slam.ForgetObjectsUnderRobot(length + 0.2, width + 0.2), 1);
+  EXPECT_EQ(slam.ConfirmedObjects().size(), confirmed.size() - 1);
+  EXPECT_EQ(slam.forgotten_under_robot(), 1);
+}
+
 TEST(OdometryIncrementTest, IsTheMoveInTheFirstPosesFrame) {
   const platform::Pose2D from{1.0, 2.0, kPi / 2};
   const platform::Pose2D to{1.0, 3.0, kPi};
