@@ -240,13 +240,30 @@ class Base : public Strategy {
     return SuccessProbability(cov, tolerance);
   }
 
+  // Half the goal structure's extent across an approach heading `heading_rad`: a box's
+  // footprint projected on the approach's sideways axis, a cylinder's radius, a stake's
+  // carrier.
+  static double GoalHalfAcross(const field::SeasonConfig& season, const field::Goal& g,
+                               double heading_rad) {
+    if (!g.on_object.empty()) return platform::CarrierRadius(season, g);
+    if (g.shape == field::SolidShape::kCylinder) return g.radius_m;
+    const double rel = heading_rad - g.yaw_deg * kPi / 180.0;
+    return 0.5 * (g.size_m.x * std::abs(std::sin(rel)) + g.size_m.y * std::abs(std::cos(rel)));
+  }
+
   // Whether the final straight approach from `stage` over `length_m` is free of known
   // objects (other than `except`, and those smaller than min_size_m): an object pinned between
   // the bumper and a goal stops the robot short, so such approaches are not offered.
+  // Into a goal structure, only an object the bumper pushes against the structure stops the
+  // robot: one further to the side than the structure's half-width across the approach (plus
+  // its own radius) is pushed along beside the structure, and the release still goes in.
   static bool CorridorFree(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& stage,
                            double length_m, int except, double min_size_m = 0.0,
                            const field::Goal* goal = nullptr) {
     const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
+    const double goal_half_across = goal && goal->kind == field::GoalKind::kGoal
+                                        ? GoalHalfAcross(*c.season, *goal, stage.z())
+                                        : std::numeric_limits<double>::infinity();
     for (const ObjectBelief& o : b.objects) {
       if (o.id == except) continue;
       // The object the goal stands on is what the robot releases onto.
@@ -261,7 +278,7 @@ class Base : public Strategy {
       const double along = rel.dot(dir);
       const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
       if (along > -r && along < length_m + c.robot->length_m / 2.0 + r &&
-          side < c.robot->width_m / 2.0 + r) {
+          side < std::min(c.robot->width_m / 2.0, goal_half_across) + r) {
         return false;
       }
     }
