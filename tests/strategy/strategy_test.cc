@@ -32,6 +32,35 @@ class StrategyTest : public ::testing::Test {
     };
     context_.is_clear = [this](const Eigen::Vector2d& p) { return planner_->IsClear(p); };
   }
+  // The season and robot the planner's map and travel times are made for.
+  void Use(const std::string& season, const std::string& robot) {
+    season_ = field::LoadSeasonConfig(season);
+    robot_ = field::LoadRobotConfig(robot);
+    ResetMap();
+  }
+  void ResetMap() {
+    map_ = std::make_unique<mapping::ObjectMap>(season_);
+    planner_ = std::make_unique<planning::Planner>(robot_);
+    planner_->SetMap(*map_);
+    travel_ = std::make_unique<TravelField>(robot_.drive);
+    travel_->SetPlanner(*planner_);
+  }
+  // The planner's first action after its survey, from `pose` holding a red block, with
+  // `objects` seen, in a 15 s period.
+  Action FirstWithABlock(const Eigen::Vector3d& pose, const std::vector<ObjectBelief>& objects) {
+    StrategyOptions options;
+    options.frame_choices = {0};
+    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
+    Belief b;
+    b.deadline_s = 15.0;
+    b.pose = pose;
+    b.held =
+        ObjectBelief{-1, "block", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
+    b.objects = objects;
+    planner->Next(b, context_);  // the survey
+    b.now_s = 0.3;
+    return planner->Next(b, context_);
+  }
   int Goal(const std::string& name) const {
     for (size_t g = 0; g < season_.goals.size(); ++g) {
       if (season_.goals[g].name == name) return static_cast<int>(g);
@@ -453,35 +482,18 @@ TEST_F(StrategyTest, SlowDrivesMakeThePlannerStartOnlyWhatStillFits) {
 // to the stage first; released from there, its straight run came in at 37 degrees and missed
 // (seed 5 with the V5 robot). On the axis behind the stage, it releases at once.
 TEST_F(StrategyTest, ATubeIsReleasedIntoOnlyFromItsAxis) {
-  season_ = field::LoadSeasonConfig("push_back");
-  robot_ = field::LoadRobotConfig("v5_drivetrain");
+  Use("push_back", "v5_drivetrain");
   // The long goal the only goal, so that the choice is between releasing and driving first.
   const auto long_goal =
       std::find_if(season_.goals.begin(), season_.goals.end(),
                    [](const field::Goal& g) { return g.name == "long_goal_left"; });
   ASSERT_NE(long_goal, season_.goals.end());
   season_.goals = {*long_goal};
-  map_ = std::make_unique<mapping::ObjectMap>(season_);
-  planner_ = std::make_unique<planning::Planner>(robot_);
-  planner_->SetMap(*map_);
-  travel_ = std::make_unique<TravelField>(robot_.drive);
-  travel_->SetPlanner(*planner_);
+  ResetMap();
   const int tube = Goal("long_goal_left");
   ASSERT_GE(tube, 0);
   ASSERT_EQ(season_.goals[tube].entry, field::Goal::Entry::kEnds);
-  const auto first = [&](const Eigen::Vector3d& pose) {
-    StrategyOptions options;
-    options.frame_choices = {0};
-    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
-    Belief b;
-    b.deadline_s = 15.0;
-    b.pose = pose;
-    b.held =
-        ObjectBelief{-1, "block", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
-    planner->Next(b, context_);  // the survey
-    b.now_s = 0.3;
-    return planner->Next(b, context_);
-  };
+  const auto first = [&](const Eigen::Vector3d& pose) { return FirstWithABlock(pose, {}); };
   const std::vector<Eigen::Vector3d> stages =
       ScoreStages(context_, tube, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
   ASSERT_FALSE(stages.empty());
@@ -507,13 +519,7 @@ TEST_F(StrategyTest, ATubeIsReleasedIntoOnlyFromItsAxis) {
 // beside it and does not. Until this rule, a block grazing the robot's side sent the Push Back
 // planner across the field to the other goal in 11 of 30 disturbed matches.
 TEST_F(StrategyTest, OnlyABlockInFrontOfTheGoalClosesTheReleaseApproach) {
-  season_ = field::LoadSeasonConfig("push_back");
-  robot_ = field::LoadRobotConfig("v5_drivetrain");
-  map_ = std::make_unique<mapping::ObjectMap>(season_);
-  planner_ = std::make_unique<planning::Planner>(robot_);
-  planner_->SetMap(*map_);
-  travel_ = std::make_unique<TravelField>(robot_.drive);
-  travel_->SetPlanner(*planner_);
+  Use("push_back", "v5_drivetrain");
   const int tube = Goal("long_goal_left");
   ASSERT_GE(tube, 0);
   const std::vector<Eigen::Vector3d> stages =
@@ -527,19 +533,8 @@ TEST_F(StrategyTest, OnlyABlockInFrontOfTheGoalClosesTheReleaseApproach) {
   // The robot on the stage, holding a red block; a blue block `side` m off the goal's axis,
   // 0.1 m short of its mouth.
   const auto first = [&](double side) {
-    StrategyOptions options;
-    options.frame_choices = {0};
-    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
-    Belief b;
-    b.deadline_s = 15.0;
-    b.pose = stage;
-    b.held =
-        ObjectBelief{-1, "block", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
-    b.objects.push_back({7, "block", "blue", mouth + Eigen::Vector2d(-0.1, side),
-                         Eigen::Matrix2d::Identity() * 1e-4, 1.0});
-    planner->Next(b, context_);  // the survey
-    b.now_s = 0.3;
-    return planner->Next(b, context_);
+    return FirstWithABlock(stage, {{7, "block", "blue", mouth + Eigen::Vector2d(-0.1, side),
+                                    Eigen::Matrix2d::Identity() * 1e-4, 1.0}});
   };
   // Beside the goal, under the robot's side: the release from here.
   const Action beside = first(0.2);
