@@ -259,13 +259,14 @@ class Base : public Strategy {
   // its own radius) is pushed along beside the structure, and the release still goes in.
   static bool CorridorFree(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& stage,
                            double length_m, int except, double min_size_m = 0.0,
-                           const field::Goal* goal = nullptr) {
+                           const field::Goal* goal = nullptr,
+                           const std::function<bool(const ObjectBelief&)>& passes = {}) {
     const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
     const double goal_half_across = goal && goal->kind == field::GoalKind::kGoal
                                         ? GoalHalfAcross(*c.season, *goal, stage.z())
                                         : std::numeric_limits<double>::infinity();
     for (const ObjectBelief& o : b.objects) {
-      if (o.id == except) continue;
+      if (o.id == except || (passes && passes(o))) continue;
       // The object the goal stands on is what the robot releases onto.
       if (goal && !goal->on_object.empty() && o.kind == goal->on_object &&
           (o.position_m - Eigen::Vector2d(goal->center_m.x, goal->center_m.y)).norm() <
@@ -591,32 +592,51 @@ class Base : public Strategy {
     // The intake takes the object whose near edge is nearest the bumper across the robot's
     // width: approach from a side where nothing else lies between the stage and the target,
     // nor beside the target with its near edge as near (kCorridorSlack_m for the errors of
-    // both positions).
+    // both positions). Objects of the target's kind and colour do not close the approach:
+    // whichever of them the intake meets first scores the same, and the cycle targets that one
+    // (Push Back's blocks lie in touching groups, every approach to one passing another).
+    const auto same = [&](const ObjectBelief& x) {
+      return x.kind == o.kind && x.colour == o.colour && Scores(c, x);
+    };
     const double corridor =
         options_.approach_margin_m + c.robot->intake.reach_m / 2.0 + kCorridorSlack_m;
     const std::optional<Eigen::Vector3d> stage =
         PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m,
-                  [&](const Eigen::Vector3d& s) { return CorridorFree(b, c, s, corridor, o.id); });
+                  [&](const Eigen::Vector3d& s) {
+                    return CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
+                  });
     if (!stage || failed_targets_.count(Key(*stage))) return out;
+    const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
+    const ObjectBelief* target = &o;
+    double nearest = (o.position_m - stage->head<2>()).dot(dir);
+    for (const ObjectBelief& x : b.objects) {
+      if (x.id == o.id || !same(x)) continue;
+      const Eigen::Vector2d rel = x.position_m - stage->head<2>();
+      const double along = rel.dot(dir);
+      const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
+      if (along > 0.0 && along < nearest && side < c.robot->width_m / 2.0 + r)
+        target = &x, nearest = along;
+    }
+    const ObjectBelief& t_o = *target;
     const std::optional<double> t = c.travel_time_s(from, *stage);
     if (!t) return out;
     const double pick_s =
         *t * Scale(kDrive) + (ApproachSeconds(c) + options_.pick_s) * Scale(kPickClass);
-    const double before = FloorPoints(*c.season, o.position_m, o.kind, o.colour, c.alliance);
-    const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
-    const Eigen::Vector3d picked_at(o.position_m.x() - dir.x() * PickDistance(*c.robot, r),
-                                    o.position_m.y() - dir.y() * PickDistance(*c.robot, r),
+    const double before = FloorPoints(*c.season, t_o.position_m, t_o.kind, t_o.colour, c.alliance);
+    const Eigen::Vector3d picked_at(t_o.position_m.x() - dir.x() * PickDistance(*c.robot, r),
+                                    t_o.position_m.y() - dir.y() * PickDistance(*c.robot, r),
                                     stage->z());
-    for (const GoalChoice& g : GoalChoices(b, c, o.kind, o.colour, picked_at, o.id)) {
+    for (const GoalChoice& g : GoalChoices(b, c, t_o.kind, t_o.colour, picked_at, t_o.id)) {
       Cycle cycle;
-      cycle.object = &o;
+      cycle.object = &t_o;
       cycle.pick_stage = *stage;
       cycle.goal = g.goal;
       cycle.score_stage = g.stage;
       cycle.seconds = pick_s + g.seconds + frames / c.frame_rate_hz;
       cycle.gain = g.points - before;
-      cycle.probability = PickProbability(b, o, frames, (o.position_m - stage->head<2>()).norm()) *
-                          ScoreProbability(b, c, g.goal, frames, o.kind, g.stage);
+      cycle.probability =
+          PickProbability(b, t_o, frames, (t_o.position_m - stage->head<2>()).norm()) *
+          ScoreProbability(b, c, g.goal, frames, t_o.kind, g.stage);
       cycle.frames = frames;
       out.push_back(cycle);
     }
@@ -905,6 +925,7 @@ class PlannerStrategy : public Base {
         for (const ObjectBelief& o : b.objects) {
           if (first.object && o.id == first.object->id) continue;
           for (const Cycle& second : ObjectCycles(b, c, o, first.score_stage, 0)) {
+            if (first.object && second.object && second.object->id == first.object->id) continue;
             consider(first, first.Value() + second.Value(), first.seconds + second.seconds);
           }
         }

@@ -45,17 +45,20 @@ class StrategyTest : public ::testing::Test {
     travel_ = std::make_unique<TravelField>(robot_.drive);
     travel_->SetPlanner(*planner_);
   }
-  // The planner's first action after its survey, from `pose` holding a red block, with
-  // `objects` seen, in a 15 s period.
-  Action FirstWithABlock(const Eigen::Vector3d& pose, const std::vector<ObjectBelief>& objects) {
-    StrategyOptions options;
+  // The planner's first action after its survey, from `pose` holding a red block (or not),
+  // with `objects` seen, `left_s` before the deadline.
+  Action FirstWithABlock(const Eigen::Vector3d& pose, const std::vector<ObjectBelief>& objects,
+                         double left_s = 14.7, bool held = true,
+                         StrategyOptions options = StrategyOptions{}) {
     options.frame_choices = {0};
     std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
     Belief b;
-    b.deadline_s = 15.0;
+    b.deadline_s = 0.3 + left_s;
     b.pose = pose;
-    b.held =
-        ObjectBelief{-1, "block", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
+    if (held) {
+      b.held =
+          ObjectBelief{-1, "block", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
+    }
     b.objects = objects;
     planner->Next(b, context_);  // the survey
     b.now_s = 0.3;
@@ -543,6 +546,47 @@ TEST_F(StrategyTest, OnlyABlockInFrontOfTheGoalClosesTheReleaseApproach) {
   // In front of the mouth: not from here.
   const Action in_front = first(0.05);
   EXPECT_FALSE(in_front.kind == ActionKind::kScore && in_front.goal_index == tube) << in_front.why;
+}
+
+// Three red blocks touching in an L: every approach to one passes another within the
+// intake's width. Whichever the intake meets first scores the same, so the group is picked
+// straight from where the robot stands (the cycle targets the block nearest the bumper).
+// Before, only approaches with no other block in the corridor were offered: here one from the
+// group's far side (heading 177 deg), and in Push Back's matches often none.
+TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
+  Use("push_back", "v5_drivetrain");
+  const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() * 1e-4;
+  const std::vector<ObjectBelief> group = {{1, "block", "red", {-0.60, 0.60}, cov, 1.0},
+                                           {2, "block", "red", {-0.60, 0.68}, cov, 1.0},
+                                           {3, "block", "red", {-0.52, 0.60}, cov, 1.0}};
+  const Eigen::Vector3d pose(-1.3, 0.64, 0.0);
+  const Action a = FirstWithABlock(pose, group, 14.7, /*held=*/false);
+  ASSERT_TRUE(a.kind == ActionKind::kNavigate || a.kind == ActionKind::kPick) << a.why;
+  ASSERT_GE(a.object_id, 1) << a.why;
+  ASSERT_LE(a.object_id, 3) << a.why;
+  // Straight in from where the robot stands, not round the group.
+  const Eigen::Vector2d centroid(-0.573, 0.627);
+  const Eigen::Vector2d to = centroid - pose.head<2>();
+  EXPECT_LT(std::abs(std::remainder(a.target.z() - std::atan2(to.y(), to.x()), 2.0 * M_PI)),
+            20.0 * M_PI / 180.0)
+      << a.why << ": heading " << a.target.z() * 180.0 / M_PI;
+  // The target is the group's block nearest the stage along the approach.
+  const Eigen::Vector2d stage = a.kind == ActionKind::kNavigate
+                                    ? Eigen::Vector2d(a.target.head<2>())
+                                    : Eigen::Vector2d(pose.head<2>());
+  const Eigen::Vector2d dir(std::cos(a.target.z()), std::sin(a.target.z()));
+  double nearest = 1e9;
+  for (const ObjectBelief& o : group) {
+    const Eigen::Vector2d rel = o.position_m - stage;
+    if (std::abs(rel.x() * dir.y() - rel.y() * dir.x()) < robot_.width_m / 2.0)
+      nearest = std::min(nearest, rel.dot(dir));
+  }
+  EXPECT_NEAR((group[a.object_id - 1].position_m - stage).dot(dir), nearest, 1e-9) << a.why;
+  // A blue block in the group closes those approaches it lies on: never picked instead.
+  std::vector<ObjectBelief> mixed = group;
+  mixed.push_back({4, "block", "blue", {-0.68, 0.60}, cov, 1.0});
+  const Action m = FirstWithABlock(pose, mixed, 14.7, /*held=*/false);
+  EXPECT_NE(m.object_id, 4) << m.why;
 }
 
 // The scripted route from the red hanging-zone tile, planned on the nominal layout: it
