@@ -22,6 +22,8 @@ using platform::kPi;
 constexpr double kAtStage_m = 0.25;
 // Position errors of the target and its neighbours the pick corridor allows for.
 constexpr double kCorridorSlack_m = 0.05;
+// Sequences less likely than this to end before the deadline are not considered.
+constexpr double kMinInTime = 0.02;
 // A staging pose for a tube's end counts as reached only this near the tube's axis.
 constexpr double kTubeAcross_m = 0.05;
 
@@ -901,8 +903,16 @@ class PlannerStrategy : public Base {
     }
     Cycle best;
     double best_j = 0.0, best_rate = 0.0;
+    // The probability that a sequence estimated at `seconds` ends before the deadline: its
+    // duration about the estimate is normal with a standard deviation of duration_spread x the
+    // estimate (0: certain, and a sequence either fits or is not considered).
+    const auto in_time = [&](double seconds) {
+      if (options_.duration_spread <= 0.0) return seconds > left ? 0.0 : 1.0;
+      return 0.5 *
+             std::erfc((seconds - left) / (options_.duration_spread * seconds * std::sqrt(2.0)));
+    };
     const auto consider = [&](const Cycle& first, double j, double seconds) {
-      if (seconds > left) return;
+      if (in_time(seconds) < kMinInTime) return;
       const double rate = j / std::max(seconds, 1e-3);
       if (j > best_j + 1e-9 || (std::abs(j - best_j) <= 1e-9 && rate > best_rate)) {
         best = first, best_j = j, best_rate = rate;
@@ -918,7 +928,7 @@ class PlannerStrategy : public Base {
         }
       }
       for (const Cycle& first : firsts) {
-        consider(first, first.Value(), first.seconds);
+        consider(first, first.Value() * in_time(first.seconds), first.seconds);
         if (options_.horizon < 2) continue;
         // The second cycle from where the first ends, with no extra observation; its travel
         // from the first's goal is the planner's, like the first's.
@@ -926,7 +936,10 @@ class PlannerStrategy : public Base {
           if (first.object && o.id == first.object->id) continue;
           for (const Cycle& second : ObjectCycles(b, c, o, first.score_stage, 0)) {
             if (first.object && second.object && second.object->id == first.object->id) continue;
-            consider(first, first.Value() + second.Value(), first.seconds + second.seconds);
+            consider(first,
+                     first.Value() * in_time(first.seconds) +
+                         second.Value() * in_time(first.seconds + second.seconds),
+                     first.seconds + second.seconds);
           }
         }
       }

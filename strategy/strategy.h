@@ -132,6 +132,14 @@ struct StrategyOptions {
   // Time cycles with the drive, pick and release estimates scaled by how long those actions
   // took so far in the match (strategy.cc, Base::Scale).
   bool learn_durations = true;
+  // Planner: how far a sequence's duration strays from its (scaled) estimate, as a standard
+  // deviation relative to the estimate. A sequence is valued by the probability that it ends
+  // before the deadline (normal about the estimate); 0: a sequence fits or is not considered.
+  // Measured (`scripts/duration-spread` on the 36 perceiving strategies' reports that
+  // `scripts/same-results record` writes, commit 09ba787): drives 0.34, releases 0.08, picks
+  // 0.16 (5 picks only); a sequence mixes them. Push Back's planner made the same points with
+  // 0.1, 0.2 and 0.3 over 30 seeds. Not calibrated per robot yet.
+  double duration_spread = 0.2;
   double prior_sigma_m = 0.05;
   double min_gain = 0.25;         // expected points below this are not worth a cycle
   int look_frames = 10;           // frames of an exploratory look

@@ -64,6 +64,8 @@ const std::map<std::string, std::string>& TunableParams() {
        "told the season file either way)"},
       {"horizon", "planner: pick-and-score cycles searched ahead"},
       {"min_gain", "planner: expected points below which a cycle is not worth it"},
+      {"duration_spread",
+       "planner: a sequence's duration about its estimate, relative sd (0: it fits or not)"},
       {"look_frames", "frames of an exploratory look"},
       {"pick_tolerance", "lateral error the intake forgives, m"},
       {"approach_margin", "staging distance before the final approach, m"},
@@ -103,6 +105,8 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->strategy_options.horizon = ToInt(name, value);
   } else if (name == "min_gain") {
     setup->strategy_options.min_gain = ToDouble(name, value);
+  } else if (name == "duration_spread") {
+    setup->strategy_options.duration_spread = ToDouble(name, value);
   } else if (name == "look_frames") {
     setup->strategy_options.look_frames = ToInt(name, value);
   } else if (name == "pick_tolerance") {

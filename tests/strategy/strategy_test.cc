@@ -589,6 +589,35 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
   EXPECT_NE(m.object_id, 4) << m.why;
 }
 
+// A release estimated to end just after the deadline: with certain durations it is not
+// started; valued by its chance of ending in time (durations stray 0.2 of the estimate) it is,
+// at less expected points. Half the time it needs is not worth trying either way.
+TEST_F(StrategyTest, ACycleThatMayEndInTimeIsTriedByItsChance) {
+  Use("push_back", "v5_drivetrain");
+  const Eigen::Vector3d start(-1.45, -0.6, 0.0);
+  StrategyOptions certain, spread;
+  certain.duration_spread = 0.0;
+  spread.duration_spread = 0.2;
+  const auto scores = [&](const Action& a) {
+    return a.goal_index >= 0 && (a.kind == ActionKind::kNavigate || a.kind == ActionKind::kScore);
+  };
+  // The shortest time left in which the certain planner still releases.
+  double fits = -1.0;
+  for (double left = 14.7; left > 0.5; left -= 0.05) {
+    if (!scores(FirstWithABlock(start, {}, left, true, certain))) break;
+    fits = left;
+  }
+  ASSERT_GT(fits, 1.0);
+  ASSERT_LT(fits, 14.0);
+  const double short_of = fits - 0.2;
+  EXPECT_FALSE(scores(FirstWithABlock(start, {}, short_of, true, certain)));
+  const Action tried = FirstWithABlock(start, {}, short_of, true, spread);
+  EXPECT_TRUE(scores(tried)) << tried.why;
+  const Action plenty = FirstWithABlock(start, {}, 14.7, true, spread);
+  EXPECT_LT(tried.expected_points, plenty.expected_points);
+  EXPECT_FALSE(scores(FirstWithABlock(start, {}, 0.5 * fits, true, spread)));
+}
+
 // The scripted route from the red hanging-zone tile, planned on the nominal layout: it
 // releases the preload, knocks a red large ball off the barrier, and its planned actions
 // fit in the period.
