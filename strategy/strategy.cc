@@ -280,10 +280,26 @@ class Base : public Strategy {
       const Eigen::Vector2d rel = o.position_m - stage.head<2>();
       const double along = rel.dot(dir);
       const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
-      if (along > -r && along < length_m + c.robot->length_m / 2.0 + r &&
-          side < std::min(c.robot->width_m / 2.0, goal_half_across) + r) {
-        return false;
+      if (along <= -r || along >= length_m + c.robot->length_m / 2.0 + r ||
+          side >= c.robot->width_m / 2.0 + r) {
+        continue;
       }
+      // Beside the structure: pushed along it only where there is room past the bumper's
+      // last position (not against a wall, as at the High Stakes wall stakes).
+      if (side >= goal_half_across + r) {
+        const double sign = rel.x() * dir.y() - rel.y() * dir.x() < 0.0 ? 1.0 : -1.0;
+        const Eigen::Vector2d left(-dir.y(), dir.x());
+        const Eigen::Vector2d pushed = stage.head<2>() +
+                                       (length_m + c.robot->length_m / 2.0 + 2.0 * r) * dir +
+                                       sign * side * left;
+        const double half = c.season->HalfSize() - r;
+        const field::ObjectType* type = c.season->FindObjectType(o.kind);
+        if (std::abs(pushed.x()) < half && std::abs(pushed.y()) < half &&
+            !platform::PointBlocksObject(*c.season, pushed, r, type ? type->height_m : 0.0)) {
+          continue;
+        }
+      }
+      return false;
     }
     return true;
   }
