@@ -618,12 +618,12 @@ class Base : public Strategy {
     };
     const double corridor =
         options_.approach_margin_m + c.robot->intake.reach_m / 2.0 + kCorridorSlack_m;
-    const std::optional<Eigen::Vector3d> stage =
+    std::optional<Eigen::Vector3d> stage =
         PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m,
                   [&](const Eigen::Vector3d& s) {
                     return CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
                   });
-    if (!stage || failed_targets_.count(Key(*stage))) return out;
+    if (!stage) return out;
     const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
     const ObjectBelief* target = &o;
     double nearest = (o.position_m - stage->head<2>()).dot(dir);
@@ -632,10 +632,20 @@ class Base : public Strategy {
       const Eigen::Vector2d rel = x.position_m - stage->head<2>();
       const double along = rel.dot(dir);
       const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
-      if (along > 0.0 && along < nearest && side < c.robot->width_m / 2.0 + r)
+      if (along > -r && along < nearest && side < c.robot->width_m / 2.0 + r)
         target = &x, nearest = along;
     }
     const ObjectBelief& t_o = *target;
+    if (target != &o) {
+      // The stage moves back along the same heading to the one nearest the bumper, whose
+      // corridor must be free in turn.
+      const Eigen::Vector2d at =
+          t_o.position_m - (PickDistance(*c.robot, r) + options_.approach_margin_m) * dir;
+      stage = Eigen::Vector3d(at.x(), at.y(), stage->z());
+      if (!c.is_clear(at) || !CorridorFree(b, c, *stage, corridor, t_o.id, 0.0, nullptr, same))
+        return out;
+    }
+    if (failed_targets_.count(Key(*stage))) return out;
     const std::optional<double> t = c.travel_time_s(from, *stage);
     if (!t) return out;
     const double pick_s =

@@ -617,11 +617,24 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
       nearest = std::min(nearest, rel.dot(dir));
   }
   EXPECT_NEAR((group[a.object_id - 1].position_m - stage).dot(dir), nearest, 1e-9) << a.why;
-  // A blue block in the group closes those approaches it lies on: never picked instead.
+  // A blue block on that straight line closes it: the approach chosen then has no blue block
+  // nearer the bumper than its target.
   std::vector<ObjectBelief> mixed = group;
-  mixed.push_back({4, "block", "blue", {-0.68, 0.60}, cov, 1.0});
+  mixed.push_back({4, "block", "blue", {-0.72, 0.63}, cov, 1.0});
   const Action m = FirstWithABlock(pose, mixed, 14.7, /*held=*/false);
-  EXPECT_NE(m.object_id, 4) << m.why;
+  ASSERT_TRUE(m.kind == ActionKind::kNavigate || m.kind == ActionKind::kPick) << m.why;
+  ASSERT_GE(m.object_id, 1) << m.why;
+  ASSERT_LE(m.object_id, 3) << m.why;
+  const Eigen::Vector2d m_stage = m.kind == ActionKind::kNavigate
+                                      ? Eigen::Vector2d(m.target.head<2>())
+                                      : Eigen::Vector2d(pose.head<2>());
+  const Eigen::Vector2d m_dir(std::cos(m.target.z()), std::sin(m.target.z()));
+  const Eigen::Vector2d blue = mixed.back().position_m - m_stage;
+  const Eigen::Vector2d aimed = mixed[m.object_id - 1].position_m - m_stage;
+  const bool blue_in_the_way =
+      std::abs(blue.x() * m_dir.y() - blue.y() * m_dir.x()) < robot_.width_m / 2.0 + 0.04 &&
+      blue.dot(m_dir) < aimed.dot(m_dir) + 0.05;
+  EXPECT_FALSE(blue_in_the_way) << m.why << ": heading " << m.target.z() * 180.0 / M_PI;
 }
 
 // A release estimated to end just after the deadline: with certain durations it is not
