@@ -939,6 +939,9 @@ class PlannerStrategy : public Base {
     };
     const auto consider = [&](const Cycle& first, double j, double seconds) {
       if (in_time(seconds) < kMinInTime) return;
+      // The executive refuses an action whose own estimate exceeds the time left: a sequence
+      // that may still end in time must at least start in time.
+      if (seconds > left && FirstAction(b, c, first, j).expected_s > left) return;
       const double rate = j / std::max(seconds, 1e-3);
       if (j > best_j + 1e-9 || (std::abs(j - best_j) <= 1e-9 && rate > best_rate)) {
         best = first, best_j = j, best_rate = rate;

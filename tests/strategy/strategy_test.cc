@@ -452,6 +452,7 @@ TEST_F(StrategyTest, SlowDrivesMakeThePlannerStartOnlyWhatStillFits) {
     StrategyOptions options;
     options.learn_durations = learn;
     options.raised_priors = false;
+    options.duration_spread = 0.0;  // a sequence fits or not
     std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
     Belief b;
     b.pose = Eigen::Vector3d(-0.45, 0.2, M_PI / 2.0);
@@ -664,6 +665,22 @@ TEST_F(StrategyTest, ACycleThatMayEndInTimeIsTriedByItsChance) {
   const Action plenty = FirstWithABlock(start, {}, 14.7, true, spread);
   EXPECT_LT(tried.expected_points, plenty.expected_points);
   EXPECT_FALSE(scores(FirstWithABlock(start, {}, 0.5 * fits, true, spread)));
+  // Whatever it tries, its first action starts in time: the executive refuses one whose own
+  // estimate exceeds the time left. On a long goal's stage, the release's own estimate.
+  const int tube = Goal("long_goal_left");
+  const std::vector<Eigen::Vector3d> stages =
+      ScoreStages(context_, tube, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
+  ASSERT_FALSE(stages.empty());
+  int tried_late = 0;
+  for (double left = 3.0; left > 0.5; left -= 0.05) {
+    for (const Eigen::Vector3d& at : stages) {
+      const Action a = FirstWithABlock(at, {}, left, true, spread);
+      if (!scores(a)) continue;
+      EXPECT_LE(a.expected_s, left) << left << ": " << a.why;
+      tried_late += a.expected_s > left;
+    }
+  }
+  EXPECT_EQ(tried_late, 0);
 }
 
 // The scripted route from the red hanging-zone tile, planned on the nominal layout: it
