@@ -300,11 +300,14 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   }
   slam_.Predict(u);
   odometry_ = now;
-  slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m);
+  const bool done =
+      std::all_of(results.begin(), results.end(), [](const platform::DriveStepResult& r) {
+        return r.status == platform::DriveStepStatus::kDone;
+      });
+  // Not after a blocked step: wheels slipping against an object carry the estimate past it.
+  if (done) slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m);
   RecordSample();
-  return std::all_of(results.begin(), results.end(), [](const platform::DriveStepResult& r) {
-    return r.status == platform::DriveStepStatus::kDone;
-  });
+  return done;
 }
 
 void MatchWorld::Wait(double seconds) { Drive({DriveStep{DriveStepKind::kWait, seconds, "wait"}}); }
