@@ -477,10 +477,11 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
       // Each segment is aimed from the latest estimate: SLAM-O corrects the encoders' drift.
       Eigen::Vector3d est = slam_.pose();
       Eigen::Vector2d d = waypoints[i] - est.head<2>();
-      // A leg shorter than the arrival tolerance is not worth its turn (on Push Back a 3 cm leg
-      // behind the robot cost a quarter turn and 1.5 s): the next leg is aimed from the
-      // estimate, and the arrival accepts the error.
-      if (d.norm() < setup_.arrival_tolerance_m) continue;
+      // The last leg, when the arrival is checked, is not worth its turn if shorter than the
+      // arrival's tolerance (on Push Back a 3 cm leg to the side cost two quarter turns and
+      // 1.5 s): the arrival accepts that error.
+      const bool checked_last = i + 1 == waypoints.size() && perceive_ && setup_.arrival_fixes > 0;
+      if (d.norm() < (checked_last ? setup_.arrival_tolerance_m : 0.02)) continue;
       // A short leg behind the robot is driven backwards: two half-turns saved (the camera
       // then looks where the robot comes from, so only for legs up to reverse_max_m).
       const bool reverse = [&]() {
