@@ -135,9 +135,9 @@ struct StrategyOptions {
   // Planner: how far a sequence's duration strays from its (scaled) estimate, as a standard
   // deviation relative to the estimate. A sequence is valued by the probability that it ends
   // before the deadline (normal about the estimate); 0: a sequence fits or is not considered.
-  // Measured (`scripts/duration-spread` on the 36 perceiving strategies' reports that
-  // `scripts/same-results record` writes, commit 09ba787): drives 0.34, releases 0.08, picks
-  // 0.16 (5 picks only); a sequence mixes them. Push Back's planner made the same points with
+  // Measured (`scripts/duration-spread` on the planner's and greedy's 24 reports that
+  // `scripts/same-results record` writes, commit 09ba787): drives 0.22, releases 0.07, picks
+  // 0.23 (2 picks only); a sequence mixes them. Push Back's planner made the same points with
   // 0.1, 0.2 and 0.3 over 30 seeds. Not calibrated per robot yet.
   double duration_spread = 0.2;
   double prior_sigma_m = 0.05;
