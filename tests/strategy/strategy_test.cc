@@ -45,20 +45,19 @@ class StrategyTest : public ::testing::Test {
     travel_ = std::make_unique<TravelField>(robot_.drive);
     travel_->SetPlanner(*planner_);
   }
-  // The planner's first action after its survey, from `pose` holding a red block (or not),
-  // with `objects` seen, `left_s` before the deadline.
-  Action FirstWithABlock(const Eigen::Vector3d& pose, const std::vector<ObjectBelief>& objects,
-                         double left_s = 14.7, bool held = true,
-                         StrategyOptions options = StrategyOptions{}) {
+  // The planner's first action after its survey, from `pose` holding a red `kind` (or
+  // nothing), with `objects` seen, `left_s` before the deadline.
+  Action FirstHolding(const Eigen::Vector3d& pose, const std::vector<ObjectBelief>& objects,
+                      double left_s = 14.7, bool held = true,
+                      StrategyOptions options = StrategyOptions{},
+                      const std::string& kind = "block") {
     options.frame_choices = {0};
     std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
     Belief b;
     b.deadline_s = 0.3 + left_s;
     b.pose = pose;
-    if (held) {
-      b.held =
-          ObjectBelief{-1, "block", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
-    }
+    if (held)
+      b.held = ObjectBelief{-1, kind, "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
     b.objects = objects;
     planner->Next(b, context_);  // the survey
     b.now_s = 0.3;
@@ -497,7 +496,7 @@ TEST_F(StrategyTest, ATubeIsReleasedIntoOnlyFromItsAxis) {
   const int tube = Goal("long_goal_left");
   ASSERT_GE(tube, 0);
   ASSERT_EQ(season_.goals[tube].entry, field::Goal::Entry::kEnds);
-  const auto first = [&](const Eigen::Vector3d& pose) { return FirstWithABlock(pose, {}); };
+  const auto first = [&](const Eigen::Vector3d& pose) { return FirstHolding(pose, {}); };
   const std::vector<Eigen::Vector3d> stages =
       ScoreStages(context_, tube, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
   ASSERT_FALSE(stages.empty());
@@ -537,8 +536,8 @@ TEST_F(StrategyTest, OnlyABlockInFrontOfTheGoalClosesTheReleaseApproach) {
   // The robot on the stage, holding a red block; a blue block `side` m off the goal's axis,
   // 0.1 m short of its mouth.
   const auto first = [&](double side) {
-    return FirstWithABlock(stage, {{7, "block", "blue", mouth + Eigen::Vector2d(-0.1, side),
-                                    Eigen::Matrix2d::Identity() * 1e-4, 1.0}});
+    return FirstHolding(stage, {{7, "block", "blue", mouth + Eigen::Vector2d(-0.1, side),
+                                 Eigen::Matrix2d::Identity() * 1e-4, 1.0}});
   };
   // Beside the goal, under the robot's side: the release from here.
   const Action beside = first(0.2);
@@ -564,18 +563,10 @@ TEST_F(StrategyTest, AnObjectBesideAGoalAgainstTheWallClosesTheApproach) {
   });
   ASSERT_NE(straight, stages.end());
   const auto first = [&](double side) {
-    StrategyOptions options;
-    options.frame_choices = {0};
-    std::unique_ptr<Strategy> planner = MakeStrategy("planner", options);
-    Belief b;
-    b.deadline_s = 15.0;
-    b.pose = *straight;
-    b.held = ObjectBelief{-1, "ring", "red", Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero(), 1.0};
-    b.objects.push_back(
-        {7, "ring", "blue", Eigen::Vector2d(-1.60, side), Eigen::Matrix2d::Identity() * 1e-4, 1.0});
-    planner->Next(b, context_);  // the survey
-    b.now_s = 0.3;
-    return planner->Next(b, context_);
+    return FirstHolding(*straight,
+                        {{7, "ring", "blue", Eigen::Vector2d(-1.60, side),
+                          Eigen::Matrix2d::Identity() * 1e-4, 1.0}},
+                        14.7, true, StrategyOptions{}, "ring");
   };
   const Action clear = first(0.6);  // well aside: released from where it stands
   EXPECT_EQ(clear.kind, ActionKind::kScore) << clear.why;
@@ -596,7 +587,7 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
                                            {2, "block", "red", {-0.60, 0.68}, cov, 1.0},
                                            {3, "block", "red", {-0.52, 0.60}, cov, 1.0}};
   const Eigen::Vector3d pose(-1.3, 0.64, 0.0);
-  const Action a = FirstWithABlock(pose, group, 14.7, /*held=*/false);
+  const Action a = FirstHolding(pose, group, 14.7, /*held=*/false);
   ASSERT_TRUE(a.kind == ActionKind::kNavigate || a.kind == ActionKind::kPick) << a.why;
   ASSERT_GE(a.object_id, 1) << a.why;
   ASSERT_LE(a.object_id, 3) << a.why;
@@ -622,7 +613,7 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
   // nearer the bumper than its target.
   std::vector<ObjectBelief> mixed = group;
   mixed.push_back({4, "block", "blue", {-0.72, 0.63}, cov, 1.0});
-  const Action m = FirstWithABlock(pose, mixed, 14.7, /*held=*/false);
+  const Action m = FirstHolding(pose, mixed, 14.7, /*held=*/false);
   ASSERT_TRUE(m.kind == ActionKind::kNavigate || m.kind == ActionKind::kPick) << m.why;
   ASSERT_GE(m.object_id, 1) << m.why;
   ASSERT_LE(m.object_id, 3) << m.why;
@@ -653,18 +644,18 @@ TEST_F(StrategyTest, ACycleThatMayEndInTimeIsTriedByItsChance) {
   // The shortest time left in which the certain planner still releases.
   double fits = -1.0;
   for (double left = 14.7; left > 0.5; left -= 0.05) {
-    if (!scores(FirstWithABlock(start, {}, left, true, certain))) break;
+    if (!scores(FirstHolding(start, {}, left, true, certain))) break;
     fits = left;
   }
   ASSERT_GT(fits, 1.0);
   ASSERT_LT(fits, 14.0);
   const double short_of = fits - 0.2;
-  EXPECT_FALSE(scores(FirstWithABlock(start, {}, short_of, true, certain)));
-  const Action tried = FirstWithABlock(start, {}, short_of, true, spread);
+  EXPECT_FALSE(scores(FirstHolding(start, {}, short_of, true, certain)));
+  const Action tried = FirstHolding(start, {}, short_of, true, spread);
   EXPECT_TRUE(scores(tried)) << tried.why;
-  const Action plenty = FirstWithABlock(start, {}, 14.7, true, spread);
+  const Action plenty = FirstHolding(start, {}, 14.7, true, spread);
   EXPECT_LT(tried.expected_points, plenty.expected_points);
-  EXPECT_FALSE(scores(FirstWithABlock(start, {}, 0.5 * fits, true, spread)));
+  EXPECT_FALSE(scores(FirstHolding(start, {}, 0.5 * fits, true, spread)));
   // Whatever it tries, its first action starts in time: the executive refuses one whose own
   // estimate exceeds the time left. On a long goal's stage, the release's own estimate.
   const int tube = Goal("long_goal_left");
@@ -674,7 +665,7 @@ TEST_F(StrategyTest, ACycleThatMayEndInTimeIsTriedByItsChance) {
   int tried_late = 0;
   for (double left = 3.0; left > 0.5; left -= 0.05) {
     for (const Eigen::Vector3d& at : stages) {
-      const Action a = FirstWithABlock(at, {}, left, true, spread);
+      const Action a = FirstHolding(at, {}, left, true, spread);
       if (!scores(a)) continue;
       EXPECT_LE(a.expected_s, left) << left << ": " << a.why;
       tried_late += a.expected_s > left;
