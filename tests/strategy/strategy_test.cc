@@ -587,6 +587,13 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
                                            {2, "block", "red", {-0.60, 0.68}, cov, 1.0},
                                            {3, "block", "red", {-0.52, 0.60}, cov, 1.0}};
   const Eigen::Vector3d pose(-1.3, 0.64, 0.0);
+  // Where a pick's straight approach starts (its stage, or here) and its direction.
+  const auto approach = [&](const Action& p) {
+    const Eigen::Vector2d from = p.kind == ActionKind::kNavigate
+                                     ? Eigen::Vector2d(p.target.head<2>())
+                                     : Eigen::Vector2d(pose.head<2>());
+    return std::make_pair(from, Eigen::Vector2d(std::cos(p.target.z()), std::sin(p.target.z())));
+  };
   const Action a = FirstHolding(pose, group, 14.7, /*held=*/false);
   ASSERT_TRUE(a.kind == ActionKind::kNavigate || a.kind == ActionKind::kPick) << a.why;
   ASSERT_GE(a.object_id, 1) << a.why;
@@ -598,10 +605,7 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
             20.0 * M_PI / 180.0)
       << a.why << ": heading " << a.target.z() * 180.0 / M_PI;
   // The target is the group's block nearest the stage along the approach.
-  const Eigen::Vector2d stage = a.kind == ActionKind::kNavigate
-                                    ? Eigen::Vector2d(a.target.head<2>())
-                                    : Eigen::Vector2d(pose.head<2>());
-  const Eigen::Vector2d dir(std::cos(a.target.z()), std::sin(a.target.z()));
+  const auto [stage, dir] = approach(a);
   double nearest = 1e9;
   for (const ObjectBelief& o : group) {
     const Eigen::Vector2d rel = o.position_m - stage;
@@ -617,10 +621,7 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
   ASSERT_TRUE(m.kind == ActionKind::kNavigate || m.kind == ActionKind::kPick) << m.why;
   ASSERT_GE(m.object_id, 1) << m.why;
   ASSERT_LE(m.object_id, 3) << m.why;
-  const Eigen::Vector2d m_stage = m.kind == ActionKind::kNavigate
-                                      ? Eigen::Vector2d(m.target.head<2>())
-                                      : Eigen::Vector2d(pose.head<2>());
-  const Eigen::Vector2d m_dir(std::cos(m.target.z()), std::sin(m.target.z()));
+  const auto [m_stage, m_dir] = approach(m);
   const Eigen::Vector2d blue = mixed.back().position_m - m_stage;
   const Eigen::Vector2d aimed = mixed[m.object_id - 1].position_m - m_stage;
   const bool blue_in_the_way =
