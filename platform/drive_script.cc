@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <deque>
 #include <sstream>
 #include <utility>
 
@@ -212,6 +213,27 @@ class Runner {
   // Stops and waits until the encoders have been still for settle_s (or max_settle_s).
   void Settle() {
     base_->Stop();
+    if (options_.settle_ticks > 0) {
+      // Readings of the last `window` periods; settled once the newest is within settle_ticks
+      // of the oldest on both wheels.
+      const int window = std::max(
+          1, static_cast<int>(std::ceil(options_.settle_s / options_.control_dt_s - 1e-9)));
+      std::deque<EncoderTicks> readings = {odometry_.last()};
+      for (double waited_s = 0.0; waited_s < options_.max_settle_s;
+           waited_s += options_.control_dt_s) {
+        Tick();
+        readings.push_back(odometry_.last());
+        if (static_cast<int>(readings.size()) <= window) continue;
+        readings.pop_front();
+        const EncoderTicks& a = readings.front();
+        const EncoderTicks& b = readings.back();
+        if (std::abs(b.left - a.left) <= options_.settle_ticks &&
+            std::abs(b.right - a.right) <= options_.settle_ticks) {
+          return;
+        }
+      }
+      return;
+    }
     double still_s = 0.0;
     for (double waited_s = 0.0; still_s < options_.settle_s && waited_s < options_.max_settle_s;
          waited_s += options_.control_dt_s) {

@@ -50,10 +50,16 @@ struct DriveControllerOptions {
   double heading_gain_per_s = 2.0;   // yaw-rate command per radian of heading error (1/s)
   double align_tolerance_deg = 1.0;  // a drive turns first if the heading is off by more (deg)
   double stop_lead_s = 0.05;         // stop this long before the target at the commanded speed (s)
-  double settle_s = 0.1;             // encoders still this long ends a step (s)
-  double max_settle_s = 2.0;         // give up waiting for the wheels to stop after this (s)
-  double timeout_factor = 3.0;       // a step times out after this times its nominal duration...
-  double timeout_margin_s = 10.0;    // ...plus this (s)
+  double settle_s = 0.1;             // encoders still this long ends a step (s)...
+  // ...or, when above 0, moving at most this many ticks per wheel over the last settle_s. With
+  // settle_s at the motors' time constant and 1 tick, what the wheels still coast after the
+  // step ends is under one tick (a first-order lag coasts speed x time constant), which the
+  // odometry counts into the next step; waiting for the last tick of the coast takes 4-6 time
+  // constants more.
+  int settle_ticks = 0;
+  double max_settle_s = 2.0;       // give up waiting for the wheels to stop after this (s)
+  double timeout_factor = 3.0;     // a step times out after this times its nominal duration...
+  double timeout_margin_s = 10.0;  // ...plus this (s)
   // The match's end on the clock (s): motion is commanded to stop when the clock reaches it,
   // whatever the step; later steps do not start. Infinite: no deadline.
   double hard_deadline_s = std::numeric_limits<double>::infinity();

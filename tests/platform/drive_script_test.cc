@@ -156,6 +156,45 @@ TEST_F(DriveScriptRunTest, StalledMotorTimesOut) {
   EXPECT_NEAR(clock.NowS(), 3.0 * 0.3 / 0.067 + 1.0, 0.5);
 }
 
+// Settling by the residual coast (DriveControllerOptions::settle_ticks): on the V5 robot's
+// motor model a step ends well before the coast's last encoder tick, and what the wheels still
+// coast after it is about one tick.
+TEST(DriveScriptSettleTest, AStepEndsOnceTheResidualCoastIsUnderATick) {
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  ASSERT_TRUE(robot.drive.slip.has_value());
+  const double tick_m = kPi * robot.drive.wheel_diameter_m / robot.drive.encoder_ticks_per_rev;
+  const auto run = [&](int settle_ticks) {
+    const std::vector<DriveStep> steps = ParseDriveScript("turn 5; forward 0.3; wait 1");
+    SimDriveBase sim(robot.drive, SimDriveOptionsFor(robot.drive), 7);
+    SimClock clock;
+    DriveControllerOptions options = DriveControllerOptionsFor(robot.drive);
+    if (settle_ticks > 0) {
+      options.settle_s = robot.drive.slip->motor_time_constant_s;
+      options.settle_ticks = settle_ticks;
+    }
+    return RunDriveScript(steps, options, &sim, &clock);
+  };
+  const std::vector<DriveStepResult> still = run(0);
+  const std::vector<DriveStepResult> coast = run(1);
+  ASSERT_EQ(still.size(), 3u);
+  ASSERT_EQ(coast.size(), 3u);
+  for (const DriveStepResult& r : coast) EXPECT_EQ(r.status, DriveStepStatus::kDone);
+  // Each step is shorter: the turn's and the drive's ends come earlier.
+  const double turn_saved_s = still[0].end_time_s - coast[0].end_time_s;
+  const double drive_saved_s =
+      (still[1].end_time_s - still[0].end_time_s) - (coast[1].end_time_s - coast[0].end_time_s);
+  EXPECT_GT(turn_saved_s, 0.1);
+  EXPECT_GT(drive_saved_s, 0.1);
+  // After the drive, the wait sees the rest of the coast: under two ticks by the encoders
+  // (one tick of residual coast, one of quantisation) and by the truth.
+  EXPECT_LT(std::abs(coast[2].odometry_pose.x_m - coast[1].odometry_pose.x_m), 2.0 * tick_m);
+  EXPECT_LT(std::hypot(coast[2].true_pose.x_m - coast[1].true_pose.x_m,
+                       coast[2].true_pose.y_m - coast[1].true_pose.y_m),
+            2.0 * tick_m);
+  // The drive still covers its distance by the encoders.
+  EXPECT_NEAR(coast[2].odometry_pose.x_m, 0.3 * std::cos(5.0 / kDegPerRad), 0.01);
+}
+
 // Drift statistics over many seeds: the calibration the simulator's defaults promise
 // (thesis appendix B: 0.05 m per 0.3 m, 2 deg spread per 90 deg turn, ~0.1 m turn slip).
 struct Stats {
