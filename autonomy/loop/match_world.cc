@@ -294,6 +294,10 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   };
   const std::vector<platform::DriveStepResult> results =
       platform::RunDriveScript(steps, drive_options_, body);
+  if (std::any_of(steps.begin(), steps.end(),
+                  [](const DriveStep& s) { return s.kind != platform::DriveStepKind::kWait; })) {
+    frames_at_rest_ = 0;
+  }
   const Pose2D now = io_->OdometryPose();
   mapping::OdometryStep u = mapping::OdometryIncrement(odometry_, now);
   u.dx_m *= odometry_scale_;
@@ -359,6 +363,7 @@ int MatchWorld::Observe(int max_frames) {
   if (taken == 0) return 0;
   if (!last_tracked) KeepView(rgbd, slam_.TrackObjects(rgbd, now_s()));
   UpdateMaps();
+  frames_at_rest_ += taken;
   return taken;
 }
 
@@ -566,7 +571,7 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   for (const strategy::ObjectBelief& o : before.objects) {
     if (o.id == action.object_id) target = o;
   }
-  if (perceive_) {
+  if (perceive_ && frames_at_rest_ == 0) {
     Observe(std::max(action.frames, setup_.correction_frames));
     for (const strategy::ObjectBelief& o : Belief().objects) {
       if (o.id == action.object_id) target = o;
@@ -604,7 +609,7 @@ bool MatchWorld::Score(const strategy::Action& action) {
   if (!held_) return false;
   const double r = ObjectRadius(held_->kind);
   const double margin = setup_.strategy_options.approach_margin_m;
-  Observe(setup_.correction_frames);
+  if (frames_at_rest_ == 0) Observe(setup_.correction_frames);
   const field::Goal& goal = field_.goals[action.goal_index];
   // A goal on a movable object (a mobile goal's stake): where the strategy saw it.
   const Eigen::Vector2d drop =

@@ -230,6 +230,9 @@ class MatchWorld {
   double odometry_scale_ = 1.0;  // true distance per encoder distance, calibrated
   std::optional<strategy::ObjectBelief> held_;
   std::vector<int> picked_ids_;  // tracker ids of objects taken off the field
+  // Frames taken since the robot last moved: a pick or score right after a look at the same
+  // standstill does not look again (the same view, and the same per-stop bias counted twice).
+  int frames_at_rest_ = 0;
   std::vector<PoseSample> samples_;
   std::vector<Snapshot> snapshots_;
   std::shared_ptr<const CameraView> camera_view_;  // the last frame seen, for the snapshots

@@ -436,10 +436,12 @@ TEST(Executive, TheV5RobotReentersALongGoalAlongItsAxisAndBacksUpShortLegs) {
   EXPECT_LT(drive_back(backwards), drive_back(forwards) - 0.5);
 }
 
-// Toss Up seed 7: after knocking the first large ball off the barrier, the planner finds a red
-// buckyball on the floor just short of the barrier and pushes it under into the goal zone
-// (2 points there, 1 where it lay). The attempt is judged on the simulator's ball, and the
-// match gains 2 more than the same seed without floor pushes (the other knock still lands).
+// Toss Up seed 11: the planner finds a red buckyball on the floor and pushes it into a zone
+// that pays more. The attempt is judged on the simulator's ball, and the match gains 2 more
+// than the same seed without floor pushes. (Seed 7 was used until the pick and release stopped
+// looking twice from one standstill; its push then missed. Over seeds 1-30 with duration_spread
+// 0, `slamo tune --season toss_up --param strategy=planner --param floor_push=0,1 --param
+// duration_spread=0`, 10 matches pushed and 8 of those pushes scored.)
 TEST(Executive, APushAlongTheFloorIsJudgedAndScores) {
   const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
   const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
@@ -448,7 +450,7 @@ TEST(Executive, APushAlongTheFloorIsJudgedAndScores) {
     setup.strategy = "planner";
     setup.strategy_options.floor_pushes = pushes;
     setup.strategy_options.duration_spread = 0.0;  // as when the seed was chosen
-    return RunMatch(season, robot, setup, 7);
+    return RunMatch(season, robot, setup, 11);
   };
   const MatchResult with = run(true), without = run(false);
   int pushes = 0, scored = 0;
@@ -505,6 +507,33 @@ TEST(Executive, ALegShorterThanTheArrivalToleranceIsNotTurnedFor) {
   EXPECT_NEAR(std::remainder(after.z() - pose.z(), 2.0 * M_PI), 0.0, 5.0 * M_PI / 180.0);
   // The arrival's look only (5 frames at 30 Hz), no quarter turns.
   EXPECT_LT(world.now_s() - start_s, 0.5);
+}
+
+// A release right after a look from the same standstill does not look again (the same view,
+// and the stop's shared bias would be counted twice); after the robot moved, it does.
+TEST(Executive, AReleaseLooksOnlyWhenTheRobotMovedSinceTheLastLook) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  MatchSetup setup;
+  ASSERT_GT(setup.correction_frames, 0);
+  strategy::Action score;
+  score.kind = strategy::ActionKind::kScore;
+  score.goal_index = 0;
+  for (const bool moved : {false, true}) {
+    MatchWorld world(MakeSimIo(field::Alliance::kRed, 1), season, robot, setup, 1, true);
+    ASSERT_TRUE(world.Belief().held.has_value());  // the preload
+    ASSERT_GT(world.Observe(5), 0);
+    if (moved) {
+      ASSERT_TRUE(world.TurnTo(world.slam().pose().z() + 0.3));
+    }
+    const int frames_before = world.frames();
+    world.Score(score);
+    if (moved) {
+      EXPECT_GT(world.frames(), frames_before);
+    } else {
+      EXPECT_EQ(world.frames(), frames_before);
+    }
+  }
 }
 
 TEST(Executive, ActionThatWouldOverrunIsNotStarted) {
