@@ -214,23 +214,25 @@ class Runner {
   void Settle() {
     base_->Stop();
     if (options_.settle_ticks > 0) {
-      // Readings of the last `window` periods; settled once the newest is within settle_ticks
-      // of the oldest on both wheels.
-      const int window = std::max(
-          1, static_cast<int>(std::ceil(options_.settle_s / options_.control_dt_s - 1e-9)));
+      // The readings since the stop. Settled once, over the newest stretch of at least settle_s
+      // by the readings' own clock (a repeated reading from a late link adds no time), each
+      // wheel moved at most settle_ticks in all, back and forth counted.
       std::deque<EncoderTicks> readings = {odometry_.last()};
+      const double span_s = options_.settle_s - 1e-9;
       for (double waited_s = 0.0; waited_s < options_.max_settle_s;
            waited_s += options_.control_dt_s) {
         Tick();
         readings.push_back(odometry_.last());
-        if (static_cast<int>(readings.size()) <= window) continue;
-        readings.pop_front();
-        const EncoderTicks& a = readings.front();
-        const EncoderTicks& b = readings.back();
-        if (std::abs(b.left - a.left) <= options_.settle_ticks &&
-            std::abs(b.right - a.right) <= options_.settle_ticks) {
-          return;
+        while (readings.size() > 2 && readings.back().t_s - readings[1].t_s >= span_s) {
+          readings.pop_front();
         }
+        if (readings.back().t_s - readings.front().t_s < span_s) continue;
+        int64_t left = 0, right = 0;
+        for (size_t k = 1; k < readings.size(); ++k) {
+          left += std::abs(readings[k].left - readings[k - 1].left);
+          right += std::abs(readings[k].right - readings[k - 1].right);
+        }
+        if (left <= options_.settle_ticks && right <= options_.settle_ticks) return;
       }
       return;
     }

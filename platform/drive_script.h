@@ -51,11 +51,13 @@ struct DriveControllerOptions {
   double align_tolerance_deg = 1.0;  // a drive turns first if the heading is off by more (deg)
   double stop_lead_s = 0.05;         // stop this long before the target at the commanded speed (s)
   double settle_s = 0.1;             // encoders still this long ends a step (s)...
-  // ...or, when above 0, moving at most this many ticks per wheel over the last settle_s. With
-  // settle_s at the motors' time constant and 1 tick, what the wheels still coast after the
-  // step ends is under one tick (a first-order lag coasts speed x time constant), which the
-  // odometry counts into the next step; waiting for the last tick of the coast takes 4-6 time
-  // constants more.
+  // ...or, when above 0, moving at most this many ticks per wheel over the last settle_s (by
+  // the readings' clock, back and forth counted). A first-order motor lag with time constant
+  // tau coasts speed x tau once cut, and over a window T >= tau it covers speed x tau x
+  // (e^(T/tau) - 1), at least 1.7 times that; so with settle_s at the time constant (rounded up
+  // to control periods) and 1 tick measured (under 2 travelled), what is left to coast is
+  // about a tick, which the odometry counts into the next step. Waiting for the coast's last
+  // tick takes 4-6 time constants more.
   int settle_ticks = 0;
   double max_settle_s = 2.0;       // give up waiting for the wheels to stop after this (s)
   double timeout_factor = 3.0;     // a step times out after this times its nominal duration...

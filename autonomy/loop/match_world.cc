@@ -175,7 +175,7 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
   drive_options_.max_settle_s = 0.4;
   // A robot file with its motors' time constant: a step ends once the residual coast is under
   // one encoder tick (DriveControllerOptions::settle_ticks), not at the coast's last tick. On
-  // the V5 robot that ends a 5-degree turn 0.14 s sooner and a 0.3 m drive 0.22 s sooner
+  // the V5 robot that ends a 5-degree turn 0.10 s sooner and a 0.3 m drive 0.20 s sooner
   // (DriveScriptSettleTest); a 15 s period has 15-25 steps.
   if (robot_.drive.slip) {
     drive_options_.settle_s = robot_.drive.slip->motor_time_constant_s;
