@@ -588,6 +588,7 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   Drive(steps);
   if (now_s() >= deadline_s_) return false;
   const std::optional<IntakeItem> picked = io_->Pick(target);
+  frames_at_rest_ = 0;  // what lay in front of the intake has changed
   Wait(context_.robot ? setup_.strategy_options.pick_s : 1.0);
   if (!picked) return false;
   // The intake knows what it took (kind and colour from its own sensor, or taken on trust).
@@ -649,6 +650,7 @@ bool MatchWorld::Drop(const strategy::Action& action) {
   if (now_s() >= deadline_s_) return false;
   // No back-off as after a score: nothing presses against the robot here.
   const std::optional<ReleaseOutcome> released = io_->Release(-1);
+  frames_at_rest_ = 0;  // the object now lies in front of the robot
   Wait(setup_.strategy_options.release_s);
   if (!released) return false;
   held_.reset();
