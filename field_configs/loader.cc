@@ -520,9 +520,13 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   }
 
   const YamlReader intake = root.Required("intake");
-  intake.AllowKeys({"reach_m", "capacity"});
+  intake.AllowKeys({"reach_m", "capacity", "pick_s", "release_s"});
   robot->intake.reach_m = intake.Required("reach_m").InRange(0.0, 1.0);
   robot->intake.capacity = intake.Required("capacity").IntInRange(0, 100);
+  if (const std::optional<YamlReader> v = intake.Optional("pick_s"))
+    robot->intake.pick_s = v->InRange(0.0, 10.0);
+  if (const std::optional<YamlReader> v = intake.Optional("release_s"))
+    robot->intake.release_s = v->InRange(0.0, 10.0);
 
   const YamlReader camera = root.Required("camera");
   camera.AllowKeys({"model", "width_px", "height_px", "cx", "cy", "fx", "fy", "min_range_m",

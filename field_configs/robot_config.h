@@ -129,8 +129,10 @@ struct CameraConfig {
 };
 
 struct IntakeConfig {
-  double reach_m = 0.0;  // how far in front of the bumper an object can be picked
-  int capacity = 1;      // objects held at once
+  double reach_m = 0.0;    // how far in front of the bumper an object can be picked
+  int capacity = 1;        // objects held at once
+  double pick_s = 1.0;     // the intake taking an object in, once the bumper is at it
+  double release_s = 1.0;  // letting a held object out
 };
 
 struct RobotConfig {

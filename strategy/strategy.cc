@@ -351,7 +351,8 @@ class Base : public Strategy {
                                             : c.travel_time_s(from, stage);
         if (!t) continue;
         const double seconds =
-            *t * Scale(kDrive) + (ApproachSeconds(c) + options_.release_s) * Scale(kReleaseClass);
+            *t * Scale(kDrive) +
+            (ApproachSeconds(c) + c.robot->intake.release_s) * Scale(kReleaseClass);
         if (best.goal < 0 || seconds < best.seconds) best = {g, stage, seconds, points};
       }
       if (best.goal >= 0) out.push_back(best);
@@ -649,7 +650,7 @@ class Base : public Strategy {
     const std::optional<double> t = c.travel_time_s(from, *stage);
     if (!t) return out;
     const double pick_s =
-        *t * Scale(kDrive) + (ApproachSeconds(c) + options_.pick_s) * Scale(kPickClass);
+        *t * Scale(kDrive) + (ApproachSeconds(c) + c.robot->intake.pick_s) * Scale(kPickClass);
     const double before = FloorPoints(*c.season, t_o.position_m, t_o.kind, t_o.colour, c.alliance);
     const Eigen::Vector3d picked_at(t_o.position_m.x() - dir.x() * PickDistance(*c.robot, r),
                                     t_o.position_m.y() - dir.y() * PickDistance(*c.robot, r),
@@ -743,7 +744,7 @@ class Base : public Strategy {
       a.target =
           Eigen::Vector3d(cycle.object->position_m.x(), cycle.object->position_m.y(), stage.z());
       a.frames = 0;
-      a.expected_s = ApproachSeconds(c) + options_.pick_s;
+      a.expected_s = ApproachSeconds(c) + c.robot->intake.pick_s;
       a.why =
           cycle.object->colour + " " + cycle.object->kind + " #" + std::to_string(cycle.object->id);
     } else {
@@ -752,7 +753,7 @@ class Base : public Strategy {
       a.goal_m = Eigen::Vector2d(c.season->goals[cycle.goal].center_m.x,
                                  c.season->goals[cycle.goal].center_m.y);
       a.target = stage;
-      a.expected_s = ApproachSeconds(c) + options_.release_s;
+      a.expected_s = ApproachSeconds(c) + c.robot->intake.release_s;
       a.why = "into " + c.season->goals[cycle.goal].name;
     }
     return a;
@@ -789,7 +790,7 @@ class Base : public Strategy {
     a.kind = ActionKind::kDrop;
     a.target = Eigen::Vector3d(b.pose.x(), b.pose.y(), best_heading);
     const double turn_deg = std::abs(Wrap(best_heading - b.pose.z())) * 180.0 / kPi;
-    a.expected_s = turn_deg / c.robot->drive.turn_rate_dps + options_.release_s;
+    a.expected_s = turn_deg / c.robot->drive.turn_rate_dps + c.robot->intake.release_s;
     a.why = b.held->colour + " " + b.held->kind + " scores nothing for us: free the intake";
     return a;
   }
@@ -1204,7 +1205,7 @@ class ScriptedStrategy : public Base {
       pick.object_kind = o.kind;
       pick.object_colour = o.colour;
       pick.target = Eigen::Vector3d(o.position_m.x(), o.position_m.y(), cycle.pick_stage.z());
-      pick.expected_s = ApproachSeconds(c) + options_.pick_s;
+      pick.expected_s = ApproachSeconds(c) + c.robot->intake.pick_s;
       pick.why = "script: pick";
       route_.push_back(pick);
       const double r = ObjectRadius(*c.season, o.kind);
@@ -1225,7 +1226,7 @@ class ScriptedStrategy : public Base {
     score.goal_m = Eigen::Vector2d(c.season->goals[cycle.goal].center_m.x,
                                    c.season->goals[cycle.goal].center_m.y);
     score.target = cycle.score_stage;
-    score.expected_s = ApproachSeconds(c) + options_.release_s;
+    score.expected_s = ApproachSeconds(c) + c.robot->intake.release_s;
     score.why = "script: release";
     route_.push_back(score);
   }

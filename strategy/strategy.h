@@ -104,8 +104,6 @@ struct Action {
 // Durations and tolerances the strategy plans with (measured on the simulator or the robot).
 struct StrategyOptions {
   int horizon = 2;                  // pick-and-score cycles searched ahead
-  double pick_s = 1.0;              // intake time, seconds
-  double release_s = 1.0;           // release time, seconds
   double approach_margin_m = 0.15;  // staging pose this far before the final straight approach
   double push_run_in_m = 0.35;      // knock: straight run-in to the object on a raised structure
   double pick_tolerance_m = 0.12;   // lateral error the intake forgives

@@ -589,7 +589,7 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   if (now_s() >= deadline_s_) return false;
   const std::optional<IntakeItem> picked = io_->Pick(target);
   frames_at_rest_ = 0;  // what lay in front of the intake has changed
-  Wait(context_.robot ? setup_.strategy_options.pick_s : 1.0);
+  Wait(robot_.intake.pick_s);
   if (!picked) return false;
   // The intake knows what it took (kind and colour from its own sensor, or taken on trust).
   // Another kind or colour than the target's: the intake took a neighbour, and the target is
@@ -635,7 +635,7 @@ bool MatchWorld::Score(const strategy::Action& action) {
   Drive(steps);
   if (now_s() >= deadline_s_) return false;
   const std::optional<ReleaseOutcome> released = io_->Release(action.goal_index);
-  Wait(setup_.strategy_options.release_s);
+  Wait(robot_.intake.release_s);
   // Back off the goal: pressed against it, the robot could not turn (its corners sweep the
   // structure) and its wheels would spin in place.
   if (now_s() < deadline_s_) Drive({Forward(-kBackOff_m / odometry_scale_)});
@@ -651,7 +651,7 @@ bool MatchWorld::Drop(const strategy::Action& action) {
   // No back-off as after a score: nothing presses against the robot here.
   const std::optional<ReleaseOutcome> released = io_->Release(-1);
   frames_at_rest_ = 0;  // the object now lies in front of the robot
-  Wait(setup_.strategy_options.release_s);
+  Wait(robot_.intake.release_s);
   if (!released) return false;
   held_.reset();
   return true;

@@ -214,5 +214,19 @@ TEST_F(RobotValidationTest, StopBiasIsRequiredAndBounded) {
       << missing.what();
 }
 
+// The intake's times are the robot's: read from the file (1 s each when left out), and
+// bounded.
+TEST_F(RobotValidationTest, IntakeTimesAreReadAndBounded) {
+  const RobotConfig shipped = ParseRobotConfig(text_, "r.yaml");
+  EXPECT_DOUBLE_EQ(shipped.intake.pick_s, 1.0);
+  const RobotConfig quick = ParseRobotConfig(
+      Edit(Edit(text_, "  pick_s: 1.0", "  pick_s: 0.4"), "  release_s: 1.0", "  release_s: 0.3"),
+      "r.yaml");
+  EXPECT_DOUBLE_EQ(quick.intake.pick_s, 0.4);
+  EXPECT_DOUBLE_EQ(quick.intake.release_s, 0.3);
+  const ConfigError negative = Reject(Edit(text_, "  pick_s: 1.0", "  pick_s: -1"));
+  EXPECT_EQ(negative.key_path(), "intake.pick_s");
+}
+
 }  // namespace
 }  // namespace slamo::field

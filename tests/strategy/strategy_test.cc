@@ -517,6 +517,29 @@ TEST_F(StrategyTest, ATubeIsReleasedIntoOnlyFromItsAxis) {
   EXPECT_EQ(behind.kind, ActionKind::kScore) << behind.why;
 }
 
+// A release is timed with the robot file's intake: a quicker intake, a shorter estimate.
+TEST_F(StrategyTest, AReleaseIsTimedWithTheRobotFilesIntake) {
+  Use("push_back", "v5_drivetrain");
+  const auto long_goal =
+      std::find_if(season_.goals.begin(), season_.goals.end(),
+                   [](const field::Goal& g) { return g.name == "long_goal_left"; });
+  ASSERT_NE(long_goal, season_.goals.end());
+  season_.goals = {*long_goal};
+  ResetMap();
+  const std::vector<Eigen::Vector3d> stages =
+      ScoreStages(context_, 0, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
+  ASSERT_FALSE(stages.empty());
+  const Eigen::Vector3d stage = *std::min_element(
+      stages.begin(), stages.end(),
+      [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.x() < b.x(); });
+  const Action slow = FirstHolding(stage, {});
+  robot_.intake.release_s = 0.25;
+  const Action quick = FirstHolding(stage, {});
+  ASSERT_EQ(slow.kind, ActionKind::kScore) << slow.why;
+  ASSERT_EQ(quick.kind, ActionKind::kScore) << quick.why;
+  EXPECT_NEAR(slow.expected_s - quick.expected_s, 1.0 - 0.25, 1e-9);
+}
+
 // Into a goal structure a block the bumper would pin against it closes the approach; one to
 // the side of the structure (the long goal is 0.14 m wide, the robot 0.44 m) is pushed along
 // beside it and does not. Until this rule, a block grazing the robot's side sent the Push Back

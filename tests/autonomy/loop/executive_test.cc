@@ -536,6 +536,26 @@ TEST(Executive, AReleaseLooksOnlyWhenTheRobotMovedSinceTheLastLook) {
   }
 }
 
+// The release takes the robot file's time: the same release with a quicker intake ends that
+// much sooner.
+TEST(Executive, AReleaseTakesTheRobotFilesIntakeTime) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+  field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  MatchSetup setup;
+  strategy::Action score;
+  score.kind = strategy::ActionKind::kScore;
+  score.goal_index = 0;
+  const auto release_time = [&](double release_s) {
+    robot.intake.release_s = release_s;
+    MatchWorld world(MakeSimIo(field::Alliance::kRed, 1), season, robot, setup, 1, true);
+    world.Observe(5);
+    const double start_s = world.now_s();
+    world.Score(score);
+    return world.now_s() - start_s;
+  };
+  EXPECT_NEAR(release_time(1.0) - release_time(0.2), 0.8, 0.03);
+}
+
 TEST(Executive, ActionThatWouldOverrunIsNotStarted) {
   field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
   season.rules.autonomous_s = 5.0;
