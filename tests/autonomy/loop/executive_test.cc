@@ -509,31 +509,47 @@ TEST(Executive, ALegShorterThanTheArrivalToleranceIsNotTurnedFor) {
   EXPECT_LT(world.now_s() - start_s, 0.5);
 }
 
-// A release right after a look from the same standstill does not look again (the same view,
-// and the stop's shared bias would be counted twice); after the robot moved, it does.
-TEST(Executive, AReleaseLooksOnlyWhenTheRobotMovedSinceTheLastLook) {
+// A pick or release right after a look from the same standstill does not look again (the same
+// view, and the stop's shared bias would be counted twice); after the robot moved, or after a
+// release on the floor put the held object in front of it, it does.
+TEST(Executive, APickOrReleaseLooksOnlyWhenTheSceneChangedSinceTheLastLook) {
   const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
   MatchSetup setup;
   ASSERT_GT(setup.correction_frames, 0);
-  strategy::Action score;
-  score.kind = strategy::ActionKind::kScore;
-  score.goal_index = 0;
-  for (const bool moved : {false, true}) {
+  enum class Before { kNothing, kTurn, kDrop };
+  // The frames the action took after a 5-frame look and then `before`.
+  const auto frames_of = [&](strategy::ActionKind kind, Before before) {
     MatchWorld world(MakeSimIo(field::Alliance::kRed, 1), season, robot, setup, 1, true);
-    ASSERT_TRUE(world.Belief().held.has_value());  // the preload
-    ASSERT_GT(world.Observe(5), 0);
-    if (moved) {
-      ASSERT_TRUE(world.TurnTo(world.slam().pose().z() + 0.3));
+    EXPECT_TRUE(world.Belief().held.has_value());  // the preload
+    EXPECT_GT(world.Observe(5), 0);
+    const Eigen::Vector3d pose = world.slam().pose();
+    if (before == Before::kTurn) {
+      EXPECT_TRUE(world.TurnTo(pose.z() + 0.3));
     }
+    if (before == Before::kDrop) {
+      strategy::Action drop;
+      drop.kind = strategy::ActionKind::kDrop;
+      drop.target = pose;  // where it faces: no turn
+      EXPECT_TRUE(world.Drop(drop));
+    }
+    strategy::Action a;
+    a.kind = kind;
+    a.goal_index = 0;
+    a.target = pose + Eigen::Vector3d(0.5 * std::cos(pose.z()), 0.5 * std::sin(pose.z()), 0.0);
     const int frames_before = world.frames();
-    world.Score(score);
-    if (moved) {
-      EXPECT_GT(world.frames(), frames_before);
+    if (kind == strategy::ActionKind::kScore) {
+      world.Score(a);
     } else {
-      EXPECT_EQ(world.frames(), frames_before);
+      world.Pick(a);
     }
-  }
+    return world.frames() - frames_before;
+  };
+  EXPECT_EQ(frames_of(strategy::ActionKind::kScore, Before::kNothing), 0);
+  EXPECT_GT(frames_of(strategy::ActionKind::kScore, Before::kTurn), 0);
+  EXPECT_EQ(frames_of(strategy::ActionKind::kPick, Before::kNothing), 0);
+  EXPECT_GT(frames_of(strategy::ActionKind::kPick, Before::kTurn), 0);
+  EXPECT_GT(frames_of(strategy::ActionKind::kPick, Before::kDrop), 0);
 }
 
 // The release takes the robot file's time: the same release with a quicker intake ends that
