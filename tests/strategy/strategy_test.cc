@@ -63,6 +63,15 @@ class StrategyTest : public ::testing::Test {
     b.now_s = 0.3;
     return planner->Next(b, context_);
   }
+  // Keeps only the goal `name` (its index becomes 0); false when the season has none.
+  bool OnlyGoal(const std::string& name) {
+    const auto it = std::find_if(season_.goals.begin(), season_.goals.end(),
+                                 [&](const field::Goal& g) { return g.name == name; });
+    if (it == season_.goals.end()) return false;
+    season_.goals = {*it};
+    ResetMap();
+    return true;
+  }
   int Goal(const std::string& name) const {
     for (size_t g = 0; g < season_.goals.size(); ++g) {
       if (season_.goals[g].name == name) return static_cast<int>(g);
@@ -487,12 +496,7 @@ TEST_F(StrategyTest, SlowDrivesMakeThePlannerStartOnlyWhatStillFits) {
 TEST_F(StrategyTest, ATubeIsReleasedIntoOnlyFromItsAxis) {
   Use("push_back", "v5_drivetrain");
   // The long goal the only goal, so that the choice is between releasing and driving first.
-  const auto long_goal =
-      std::find_if(season_.goals.begin(), season_.goals.end(),
-                   [](const field::Goal& g) { return g.name == "long_goal_left"; });
-  ASSERT_NE(long_goal, season_.goals.end());
-  season_.goals = {*long_goal};
-  ResetMap();
+  ASSERT_TRUE(OnlyGoal("long_goal_left"));
   const int tube = Goal("long_goal_left");
   ASSERT_GE(tube, 0);
   ASSERT_EQ(season_.goals[tube].entry, field::Goal::Entry::kEnds);
@@ -520,12 +524,7 @@ TEST_F(StrategyTest, ATubeIsReleasedIntoOnlyFromItsAxis) {
 // A release is timed with the robot file's intake: a quicker intake, a shorter estimate.
 TEST_F(StrategyTest, AReleaseIsTimedWithTheRobotFilesIntake) {
   Use("push_back", "v5_drivetrain");
-  const auto long_goal =
-      std::find_if(season_.goals.begin(), season_.goals.end(),
-                   [](const field::Goal& g) { return g.name == "long_goal_left"; });
-  ASSERT_NE(long_goal, season_.goals.end());
-  season_.goals = {*long_goal};
-  ResetMap();
+  ASSERT_TRUE(OnlyGoal("long_goal_left"));
   const std::vector<Eigen::Vector3d> stages =
       ScoreStages(context_, 0, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
   ASSERT_FALSE(stages.empty());
