@@ -360,6 +360,38 @@ class Base : public Strategy {
     return out;
   }
 
+  // Points our objects lose when the robot drives straight from `from` to `to`: an object
+  // it may push (not an obstacle on the planner's map) earning us points where it lies, met
+  // within half the robot's width of its line, is carried to the bumper's end of the drive;
+  // what it earns there is subtracted. (The planner's path is the straight line unless an
+  // obstacle bends it.)
+  double PushLoss(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& from,
+                  const Eigen::Vector3d& to) const {
+    const Eigen::Vector2d d = to.head<2>() - from.head<2>();
+    const double length = d.norm();
+    if (length < 0.05) return 0.0;
+    const Eigen::Vector2d dir = d / length;
+    double loss = 0.0;
+    for (const ObjectBelief& o : b.objects) {
+      if (!c.is_clear(o.position_m)) continue;  // an obstacle: driven round
+      const int now = FloorPoints(*c.season, o.position_m, o.kind, o.colour, c.alliance);
+      if (now <= 0) continue;
+      const double r = ObjectRadius(*c.season, o.kind);
+      const Eigen::Vector2d rel = o.position_m - from.head<2>();
+      const double along = rel.dot(dir);
+      const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
+      if (along <= 0.0 || along >= length + c.robot->length_m / 2.0 ||
+          side >= c.robot->width_m / 2.0 + r) {
+        continue;
+      }
+      const Eigen::Vector2d carried = to.head<2>() + (c.robot->length_m / 2.0 + r) * dir +
+                                      (o.position_m - from.head<2>() - along * dir);
+      const int then = FloorPoints(*c.season, carried, o.kind, o.colour, c.alliance);
+      loss += std::max(0, now - then);
+    }
+    return loss;
+  }
+
   bool Scores(const StrategyContext& c, const ObjectBelief& o) const {
     if (!field::ScoresFor(*c.season, o.colour, c.alliance)) return false;
     if (InGoalStructure(*c.season, o.position_m)) return false;
@@ -958,7 +990,13 @@ class PlannerStrategy : public Base {
         }
       }
       for (const Cycle& first : firsts) {
-        consider(first, first.Value() * in_time(first.seconds), first.seconds);
+        // What the drive to the cycle's first stage pushes out of our zones is lost whatever
+        // the cycle then earns.
+        const double loss =
+            options_.count_push_loss
+                ? PushLoss(b, c, b.pose, first.object ? first.pick_stage : first.score_stage)
+                : 0.0;
+        consider(first, first.Value() * in_time(first.seconds) - loss, first.seconds);
         if (options_.horizon < 2) continue;
         // The second cycle from where the first ends, with no extra observation; its travel
         // from the first's goal is the planner's, like the first's.
@@ -968,7 +1006,7 @@ class PlannerStrategy : public Base {
             if (first.object && second.object && second.object->id == first.object->id) continue;
             consider(first,
                      first.Value() * in_time(first.seconds) +
-                         second.Value() * in_time(first.seconds + second.seconds),
+                         second.Value() * in_time(first.seconds + second.seconds) - loss,
                      first.seconds + second.seconds);
           }
         }

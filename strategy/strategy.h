@@ -127,6 +127,9 @@ struct StrategyOptions {
   // they earn more (a push navigation, like a knock): a cycle with no pick or release.
   bool floor_pushes = true;
   double max_floor_push_m = 1.0;
+  // Planner: a sequence's value loses the points of our objects the drive to its first stage
+  // would push out of the zones they earn in (strategy.cc, Base::PushLoss).
+  bool count_push_loss = true;
   // Time cycles with the drive, pick and release estimates scaled by how long those actions
   // took so far in the match (strategy.cc, Base::Scale).
   bool learn_durations = true;

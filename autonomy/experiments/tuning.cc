@@ -73,6 +73,8 @@ const std::map<std::string, std::string>& TunableParams() {
       {"correction_frames", "frames of a quick look"},
       {"arrival_fixes", "look-and-correct rounds on arrival"},
       {"floor_push", "1: objects on the floor may be pushed into a zone that pays more; 0: never"},
+      {"push_loss",
+       "planner: 1 counts against a sequence what its first drive pushes out of our zones; 0: not"},
       {"reverse_max",
        "path legs behind the robot up to this long (m) are driven backwards (0: never)"},
       {"pushable", "objects narrower than this fraction of the robot are pushed, not avoided"},
@@ -123,6 +125,10 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     if (value != "0" && value != "1")
       throw std::invalid_argument("--param floor_push: expected 0 or 1, got \"" + value + "\"");
     setup->strategy_options.floor_pushes = value == "1";
+  } else if (name == "push_loss") {
+    if (value != "0" && value != "1")
+      throw std::invalid_argument("--param push_loss: expected 0 or 1, got \"" + value + "\"");
+    setup->strategy_options.count_push_loss = value == "1";
   } else if (name == "reverse_max") {
     setup->reverse_max_m = ToDouble(name, value);
   } else if (name == "pushable") {
