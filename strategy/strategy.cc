@@ -190,6 +190,18 @@ class Base : public Strategy {
     return across <= kTubeAcross_m && rel.dot(axis) <= kTubeAcross_m;
   }
 
+  // Seconds to drive from `from` to a cycle's first stage. None when `from` is where the robot
+  // stands (the belief's pose) and the pick, release or push starts from there (AtStage): the
+  // action turns and drives the rest itself, within its own estimate, while the travel field
+  // would charge a turn to face a stage a few centimetres off and a turn back (on Push Back 2 s
+  // for a robot 3 cm from its pick stage, after which the cycle no longer fitted).
+  std::optional<double> StageTravel(const Belief& b, const StrategyContext& c,
+                                    const Eigen::Vector3d& from, const Eigen::Vector3d& stage,
+                                    const ObjectBelief* object, bool knock, int goal) const {
+    if (from == b.pose && AtStage(c, from, stage, object, knock, goal)) return 0.0;
+    return c.travel_time_s(from, stage);
+  }
+
   // Seconds for the final straight approach of margin_m and the settling around it.
   double ApproachSeconds(const StrategyContext& c) const {
     return options_.approach_margin_m / c.robot->drive.cruise_speed_mps + 0.5;
@@ -316,8 +328,8 @@ class Base : public Strategy {
   }
 
   // The goals an object scores in, with their best staging pose from `from` and the time to
-  // get there and release. `from_robot`: `from` is where the robot stands, and a stage it
-  // releases from without driving there first (AtStage) costs no drive.
+  // get there and release (from the robot's own pose, a stage it releases from without driving
+  // there first costs no drive: StageTravel).
   struct GoalChoice {
     int goal = -1;
     Eigen::Vector3d stage;
@@ -326,8 +338,7 @@ class Base : public Strategy {
   };
   std::vector<GoalChoice> GoalChoices(const Belief& b, const StrategyContext& c,
                                       const std::string& kind, const std::string& colour,
-                                      const Eigen::Vector3d& from, int except,
-                                      bool from_robot = false) const {
+                                      const Eigen::Vector3d& from, int except) const {
     std::vector<GoalChoice> out;
     const double r = ObjectRadius(*c.season, kind);
     for (int g = 0; g < static_cast<int>(c.season->goals.size()); ++g) {
@@ -346,9 +357,7 @@ class Base : public Strategy {
                           &c.season->goals[g])) {
           continue;
         }
-        const std::optional<double> t = from_robot && AtStage(c, from, stage, nullptr, false, g)
-                                            ? 0.0
-                                            : c.travel_time_s(from, stage);
+        const std::optional<double> t = StageTravel(b, c, from, stage, nullptr, false, g);
         if (!t) continue;
         const double seconds =
             *t * Scale(kDrive) +
@@ -437,7 +446,7 @@ class Base : public Strategy {
     if (knocked_.count(o.id) || s.shape != field::SolidShape::kBox) return out;
     for (const KnockWay& way : KnockWaysFor(c, o, s)) {
       if (failed_targets_.count(Key(way.stage))) continue;
-      const std::optional<double> t = c.travel_time_s(from, way.stage);
+      const std::optional<double> t = StageTravel(b, c, from, way.stage, &o, true, way.goal);
       if (!t) continue;
       Cycle cycle;
       cycle.object = &o;
@@ -603,7 +612,7 @@ class Base : public Strategy {
         }
       }
       if (!clear) continue;
-      const std::optional<double> t = c.travel_time_s(from, stage_pose);
+      const std::optional<double> t = StageTravel(b, c, from, stage_pose, &o, true, g);
       if (!t) continue;
       Cycle cycle;
       cycle.object = &o;
@@ -679,7 +688,7 @@ class Base : public Strategy {
         return out;
     }
     if (failed_targets_.count(Key(*stage))) return out;
-    const std::optional<double> t = c.travel_time_s(from, *stage);
+    const std::optional<double> t = StageTravel(b, c, from, *stage, &t_o, false, -1);
     if (!t) return out;
     const double pick_s =
         *t * Scale(kDrive) + (ApproachSeconds(c) + c.robot->intake.pick_s) * Scale(kPickClass);
@@ -706,7 +715,7 @@ class Base : public Strategy {
 
   std::vector<Cycle> HeldCycles(const Belief& b, const StrategyContext& c, int frames) const {
     std::vector<Cycle> out;
-    for (const GoalChoice& g : GoalChoices(b, c, b.held->kind, b.held->colour, b.pose, -1, true)) {
+    for (const GoalChoice& g : GoalChoices(b, c, b.held->kind, b.held->colour, b.pose, -1)) {
       Cycle cycle;
       cycle.goal = g.goal;
       cycle.score_stage = g.stage;

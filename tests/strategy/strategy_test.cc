@@ -539,6 +539,52 @@ TEST_F(StrategyTest, AReleaseIsTimedWithTheRobotFilesIntake) {
   EXPECT_NEAR(slow.expected_s - quick.expected_s, 1.0 - 0.25, 1e-9);
 }
 
+// Standing a few centimetres off a pick's stage, the robot picks from where it is (the pick
+// turns and drives the rest itself): the cycle is timed as from the stage. The travel field
+// charges a turn to face a stage 3 cm away and a turn back (2 s for the V5 robot), and three
+// settles even for the stage itself; on Push Back the planner gave up cycles it had driven to.
+TEST_F(StrategyTest, ARobotBesideItsPickStageIsTimedAsAtIt) {
+  Use("push_back", "v5_drivetrain");
+  ASSERT_TRUE(OnlyGoal("long_goal_left"));
+  const ObjectBelief block{
+      5, "block", "red", Eigen::Vector2d(-0.6, 0.4), Eigen::Matrix2d::Identity() * 1e-4, 1.0};
+  StrategyOptions options;
+  options.duration_spread = 0.0;  // a sequence fits or is not considered
+  const Action go = FirstHolding(Eigen::Vector3d(-1.2, -0.6, 0.0), {block}, 14.7, false, options);
+  ASSERT_EQ(go.kind, ActionKind::kNavigate) << go.why;
+  ASSERT_EQ(go.object_id, 5) << go.why;
+  const Eigen::Vector3d stage = go.target;
+  // 3 cm past the stage and to its side (the drive overshot it), turned 4 degrees.
+  const Eigen::Vector2d ahead(std::cos(stage.z()), std::sin(stage.z()));
+  const Eigen::Vector2d side(-ahead.y(), ahead.x());
+  const Eigen::Vector2d off = stage.head<2>() + 0.02 * ahead + 0.02 * side;
+  const Eigen::Vector3d beside(off.x(), off.y(), stage.z() + 4.0 * M_PI / 180.0);
+  // 0.5 m before the stage, on its approach line: the drive there is the only difference.
+  const Eigen::Vector2d back = stage.head<2>() - 0.5 * ahead;
+  const Eigen::Vector3d before(back.x(), back.y(), stage.z());
+  // The least time left at which each pose still starts the cycle (pick, or drive to pick).
+  const auto least = [&](const Eigen::Vector3d& pose) {
+    double lo = 0.0, hi = 14.7;
+    for (int k = 0; k < 30; ++k) {
+      const Action a = FirstHolding(pose, {block}, 0.5 * (lo + hi), false, options);
+      const bool starts =
+          a.object_id == 5 && (a.kind == ActionKind::kPick || a.kind == ActionKind::kNavigate);
+      (starts ? hi : lo) = 0.5 * (lo + hi);
+    }
+    return hi;
+  };
+  const double at = least(stage);
+  EXPECT_LT(at, 14.0) << "the pick is started at all";
+  EXPECT_GT(at, robot_.intake.pick_s + robot_.intake.release_s) << "and timed with the cycle";
+  // Beside the stage as at it (the stage from there differs a little: the approach is chosen
+  // from where the robot stands).
+  EXPECT_NEAR(least(beside), at, 0.2);
+  // From 0.5 m before it, the drive to it more.
+  const std::optional<double> drive = travel_->TravelTimeS(before, stage);
+  ASSERT_TRUE(drive);
+  EXPECT_NEAR(least(before) - at, *drive, 0.1);
+}
+
 // Into a goal structure a block the bumper would pin against it closes the approach; one to
 // the side of the structure (the long goal is 0.14 m wide, the robot 0.44 m) is pushed along
 // beside it and does not. Until this rule, a block grazing the robot's side sent the Push Back
