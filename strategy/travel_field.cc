@@ -128,14 +128,20 @@ std::optional<double> TravelField::TravelTimeS(const Eigen::Vector3d& from,
   if (!d) return std::nullopt;
   const Eigen::Vector2d delta = to.head<2>() - from.head<2>();
   double turn_rad = 0.0;
-  if (delta.norm() > 0.02) {
-    const double bearing = std::atan2(delta.y(), delta.x());
+  double drive_m = *d;
+  if (delta.norm() > std::max(0.02, min_leg_m)) {
+    double bearing = std::atan2(delta.y(), delta.x());
+    // A short leg behind the robot is driven backwards, facing away from it.
+    if (std::abs(std::remainder(bearing - from.z(), 2 * kPi)) > kPi / 2.0 && *d <= reverse_max_m) {
+      bearing += kPi;
+    }
     turn_rad = std::abs(std::remainder(bearing - from.z(), 2 * kPi)) +
                std::abs(std::remainder(to.z() - bearing, 2 * kPi));
   } else {
     turn_rad = std::abs(std::remainder(to.z() - from.z(), 2 * kPi));
+    drive_m = 0.0;
   }
-  return turn_rad * 180.0 / kPi / drive_.turn_rate_dps + planning::DriveTime(drive_, *d) +
+  return turn_rad * 180.0 / kPi / drive_.turn_rate_dps + planning::DriveTime(drive_, drive_m) +
          3 * settle_s;
 }
 

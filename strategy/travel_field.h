@@ -29,11 +29,16 @@ class TravelField {
   // Shortest collision-free distance between two points, or nothing when unreachable. A start
   // inside the inflation (after a close approach) leaves through the nearest free cell.
   std::optional<double> DistanceM(const Eigen::Vector2d& from, const Eigen::Vector2d& to);
-  // Turn towards the target, drive the geodesic distance, turn to the final heading; plus
-  // settle_s for each of the three motions.
+  // Turn towards the target (or away from it, driving backwards: reverse_max_m), drive the
+  // geodesic distance, turn to the final heading; plus settle_s for each of the three motions.
   std::optional<double> TravelTimeS(const Eigen::Vector3d& from, const Eigen::Vector3d& to);
 
   double settle_s = 0.3;
+  // How the executive drives a path (MatchWorld::Navigate): a leg shorter than min_leg_m is
+  // not driven (the arrival accepts that error), and one behind the robot up to
+  // reverse_max_m long is driven backwards instead of turning round twice (0: never).
+  double min_leg_m = 0.0;
+  double reverse_max_m = 0.0;
 
  private:
   std::optional<int> CellOf(const Eigen::Vector2d& p) const;

@@ -195,6 +195,8 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
   planning::SeedPlanners(seed);
   planner_->SetMap(slam_.obstacle_map());
   travel_.SetPlanner(*planner_);
+  travel_.min_leg_m = perceive && setup.arrival_fixes > 0 ? setup.arrival_tolerance_m : 0.0;
+  travel_.reverse_max_m = setup.reverse_max_m;
 
   context_.season = &field_;
   context_.robot = &robot_;

@@ -154,6 +154,37 @@ TEST_F(StrategyTest, TravelTimesAreNeverShorterThanTheStraightLine) {
   EXPECT_FALSE(travel_->DistanceM(near, Eigen::Vector2d(0.61, 0.0)));
 }
 
+// Travel times follow how the executive drives (MatchWorld::Navigate): a short leg behind the
+// robot backwards, with no turn round and back; a leg shorter than the arrival's tolerance not
+// at all.
+TEST_F(StrategyTest, TravelTimesDriveShortLegsBehindBackwardsAndSkipTinyOnes) {
+  const Eigen::Vector3d from(-0.5, 0.0, 0.0), behind(-0.8, 0.0, 0.0), near(-0.48, 0.02, 0.1);
+  ASSERT_TRUE(planner_->IsClear(from.head<2>()));
+  ASSERT_TRUE(planner_->IsClear(behind.head<2>()));
+  const double turn_s = 180.0 / robot_.drive.turn_rate_dps;  // half a turn
+  const std::optional<double> round = travel_->TravelTimeS(from, behind);
+  const std::optional<double> tiny = travel_->TravelTimeS(from, near);
+  travel_->reverse_max_m = 0.6;
+  travel_->min_leg_m = 0.04;
+  const std::optional<double> backwards = travel_->TravelTimeS(from, behind);
+  const std::optional<double> skipped = travel_->TravelTimeS(from, near);
+  ASSERT_TRUE(round && tiny && backwards && skipped);
+  EXPECT_NEAR(*round - *backwards, 2.0 * turn_s, 1e-6);
+  const std::optional<double> d = travel_->DistanceM(from.head<2>(), behind.head<2>());
+  ASSERT_TRUE(d);
+  EXPECT_NEAR(*backwards, planning::DriveTime(robot_.drive, *d) + 3 * travel_->settle_s, 1e-6);
+  // 2.8 cm and 0.1 rad: the final turn only.
+  EXPECT_NEAR(*skipped, 0.1 * 180.0 / M_PI / robot_.drive.turn_rate_dps + 3 * travel_->settle_s,
+              1e-6);
+  EXPECT_GT(*tiny, *skipped + 0.5 * turn_s) << "forwards it turns to face the point and back";
+  // A longer leg behind is still driven forwards.
+  const Eigen::Vector3d far_behind(-1.3, 0.0, 0.0);
+  ASSERT_TRUE(planner_->IsClear(far_behind.head<2>()));
+  const std::optional<double> far = travel_->TravelTimeS(from, far_behind);
+  ASSERT_TRUE(far);
+  EXPECT_GT(*far, planning::DriveTime(robot_.drive, 0.8) + 2.0 * turn_s);
+}
+
 TEST_F(StrategyTest, PlannerScoresTheHeldObjectAndIdlesWhenNothingFits) {
   std::unique_ptr<Strategy> planner = MakeStrategy("planner", StrategyOptions{});
   Belief b;
