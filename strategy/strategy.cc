@@ -265,12 +265,24 @@ class Base : public Strategy {
     return 0.5 * (g.size_m.x * std::abs(std::sin(rel)) + g.size_m.y * std::abs(std::cos(rel)));
   }
 
+  // Whether a goal is a structure raised off the floor (objects lower than it pass under).
+  static bool RaisedGoal(const field::SeasonConfig& season, const field::Goal* goal) {
+    if (!goal || goal->kind != field::GoalKind::kGoal) return false;
+    for (const field::Structure& s : season.structures) {
+      if (s.name == goal->name) return s.PassUnder();
+    }
+    return false;
+  }
+
   // Whether the final straight approach from `stage` over `length_m` is free of known
   // objects (other than `except`, and those smaller than min_size_m): an object pinned between
   // the bumper and a goal stops the robot short, so such approaches are not offered.
   // Into a goal structure, only an object the bumper pushes against the structure stops the
   // robot: one further to the side than the structure's half-width across the approach (plus
-  // its own radius) is pushed along beside the structure, and the release still goes in.
+  // its own radius) is pushed along beside the structure, and the release still goes in; one
+  // straight ahead is pushed under the structure when it is raised above the object (Push
+  // Back's upper centre goal, 0.30 m up, over 0.08 m blocks), and does not stop the robot
+  // either.
   static bool CorridorFree(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& stage,
                            double length_m, int except, double min_size_m = 0.0,
                            const field::Goal* goal = nullptr,
@@ -296,9 +308,10 @@ class Base : public Strategy {
           side >= c.robot->width_m / 2.0 + r) {
         continue;
       }
-      // Beside the structure: pushed along it only where there is room past the bumper's
-      // last position (not against a wall, as at the High Stakes wall stakes).
-      if (side >= goal_half_across + r) {
+      // Beside the structure (or ahead, under a raised one): pushed along only where there is
+      // room past the bumper's last position (not against a wall, as at the High Stakes wall
+      // stakes, nor against a structure the object does not pass under).
+      if (side >= goal_half_across + r || RaisedGoal(*c.season, goal)) {
         const double sign = rel.x() * dir.y() - rel.y() * dir.x() < 0.0 ? 1.0 : -1.0;
         const Eigen::Vector2d left(-dir.y(), dir.x());
         const Eigen::Vector2d pushed = stage.head<2>() +

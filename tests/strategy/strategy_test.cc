@@ -570,6 +570,35 @@ TEST_F(StrategyTest, AReleaseIsTimedWithTheRobotFilesIntake) {
   EXPECT_NEAR(slow.expected_s - quick.expected_s, 1.0 - 0.25, 1e-9);
 }
 
+// A block straight ahead of a release's approach is pushed under a goal raised above it (Push
+// Back's upper centre goal) and does not close the approach; against one on the floor (the
+// lower centre goal) it does. Jittered blocks of the cluster beside the upper goal's near
+// entrance closed it in many matches, and the planner drove to the far one.
+TEST_F(StrategyTest, ABlockAheadIsPushedUnderARaisedGoal) {
+  Use("push_back", "v5_drivetrain");
+  const auto release_with_block_ahead = [&](const std::string& goal, const Eigen::Vector2d& near) {
+    Use("push_back", "v5_drivetrain");
+    EXPECT_TRUE(OnlyGoal(goal));
+    const std::vector<Eigen::Vector3d> stages =
+        ScoreStages(context_, 0, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
+    EXPECT_FALSE(stages.empty());
+    const Eigen::Vector3d stage = *std::min_element(
+        stages.begin(), stages.end(), [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+          return (a.head<2>() - near).norm() < (b.head<2>() - near).norm();
+        });
+    const Eigen::Vector2d ahead =
+        stage.head<2>() + 0.1 * Eigen::Vector2d(std::cos(stage.z()), std::sin(stage.z()));
+    const ObjectBelief block{9, "block", "red", ahead, Eigen::Matrix2d::Identity() * 1e-4, 1.0};
+    const Action alone = FirstHolding(stage, {});
+    EXPECT_EQ(alone.kind, ActionKind::kScore) << goal << ": " << alone.why;
+    return FirstHolding(stage, {block}).kind;
+  };
+  EXPECT_EQ(release_with_block_ahead("center_goal_upper", Eigen::Vector2d(-0.48, 0.48)),
+            ActionKind::kScore);
+  EXPECT_NE(release_with_block_ahead("center_goal_lower", Eigen::Vector2d(-0.48, -0.48)),
+            ActionKind::kScore);
+}
+
 // Standing a few centimetres off a pick's stage, the robot picks from where it is (the pick
 // turns and drives the rest itself): the cycle is timed as from the stage. The travel field
 // charges a turn to face a stage 3 cm away and a turn back (2 s for the V5 robot), and three
