@@ -190,17 +190,22 @@ class Base : public Strategy {
     return across <= kTubeAcross_m && rel.dot(axis) <= kTubeAcross_m;
   }
 
-  // Seconds to drive from `from` to a cycle's first stage. None when `from` is where the robot
-  // stands (the belief's pose) and the pick, release or push starts from there (AtStage): the
-  // action turns and drives the rest itself, within its own estimate, while the travel field
-  // would charge a turn to face a stage a few centimetres off and a turn back (on Push Back 2 s
-  // for a robot 3 cm from its pick stage, after which the cycle no longer fitted).
+  // Seconds to drive from `from` to a cycle's first stage. When `from` is where the robot
+  // stands (the belief's pose) and the pick, release or push starts from there (AtStage), only
+  // the turn to the stage's heading: the action turns and drives the rest itself, within its
+  // own estimate, while the travel field charges three settles even for the stage itself (and,
+  // before 501be41, a turn round and back for a stage 3 cm behind: 2 s on Push Back, after
+  // which the cycle no longer fitted). Not while the scripted route plans (plans_route_): it
+  // drives to every stage it planned.
   std::optional<double> StageTravel(const Belief& b, const StrategyContext& c,
                                     const Eigen::Vector3d& from, const Eigen::Vector3d& stage,
                                     const ObjectBelief* object, bool knock, int goal) const {
-    if (from == b.pose && AtStage(c, from, stage, object, knock, goal)) return 0.0;
+    if (!plans_route_ && from == b.pose && AtStage(c, from, stage, object, knock, goal)) {
+      return std::abs(Wrap(stage.z() - from.z())) * 180.0 / kPi / c.robot->drive.turn_rate_dps;
+    }
     return c.travel_time_s(from, stage);
   }
+  bool plans_route_ = false;
 
   // Seconds for the final straight approach of margin_m and the settling around it.
   double ApproachSeconds(const StrategyContext& c) const {
@@ -1162,6 +1167,7 @@ class ScriptedStrategy : public Base {
 
   void Plan(const Belief& b, const StrategyContext& c) {
     planned_ = true;
+    plans_route_ = true;  // every planned stage is driven to (Emit)
     // The nominal objects: fixed positions from the season file (regions are unknown).
     nominal_.clear();
     int id = -1;
@@ -1227,6 +1233,7 @@ class ScriptedStrategy : public Base {
       Emit(c, cycle, index, from);
       from = cycle.score_stage;
     }
+    plans_route_ = false;
   }
 
   // The actions of one planned cycle, starting from `from`.

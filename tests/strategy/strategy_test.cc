@@ -581,7 +581,10 @@ TEST_F(StrategyTest, ABlockAheadIsPushedUnderARaisedGoal) {
     EXPECT_TRUE(OnlyGoal(goal));
     const std::vector<Eigen::Vector3d> stages =
         ScoreStages(context_, 0, 0.5 * season_.FindObjectType("block")->size_m, 0.15);
-    EXPECT_FALSE(stages.empty());
+    if (stages.empty()) {
+      ADD_FAILURE() << goal << " has no staging pose";
+      return ActionKind::kIdle;
+    }
     const Eigen::Vector3d stage = *std::min_element(
         stages.begin(), stages.end(), [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
           return (a.head<2>() - near).norm() < (b.head<2>() - near).norm();
@@ -600,9 +603,10 @@ TEST_F(StrategyTest, ABlockAheadIsPushedUnderARaisedGoal) {
 }
 
 // Standing a few centimetres off a pick's stage, the robot picks from where it is (the pick
-// turns and drives the rest itself): the cycle is timed as from the stage. The travel field
-// charges a turn to face a stage 3 cm away and a turn back (2 s for the V5 robot), and three
-// settles even for the stage itself; on Push Back the planner gave up cycles it had driven to.
+// turns and drives the rest itself): the cycle is timed as from the stage, with the turn to
+// its heading. Timed with the travel field it carried three settles even at the stage itself
+// (and, without the executive's rules for short legs, a turn round and back for a stage just
+// behind: 2 s for the V5 robot); on Push Back the planner gave up cycles it had driven to.
 TEST_F(StrategyTest, ARobotBesideItsPickStageIsTimedAsAtIt) {
   Use("push_back", "v5_drivetrain");
   ASSERT_TRUE(OnlyGoal("long_goal_left"));

@@ -476,9 +476,7 @@ TEST(Executive, TheV5RobotScoresRingsOnAHighStakesMobileGoal) {
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
   MatchSetup setup;
   setup.strategy = "scripted";
-  // Seed 5: on seed 1, since the pick stages are timed from where the robot stands, the route
-  // plans a third cycle and its second release misses (+1); over 100 seeds it makes the same.
-  const MatchResult r = RunMatch(season, robot, setup, 5);
+  const MatchResult r = RunMatch(season, robot, setup, 1);
   EXPECT_GE(r.points - r.points_start, 2) << "the preload and one ring (measured +2)";
   EXPECT_EQ(r.overrun_s, 0.0);
   for (const AttemptCheck& a : r.attempts) {
