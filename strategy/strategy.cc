@@ -347,7 +347,7 @@ class Base : public Strategy {
 
   // The goals an object scores in, with their best staging pose from `from` and the time to
   // get there and release (from the robot's own pose, a stage it releases from without driving
-  // there first costs no drive: StageTravel).
+  // there first costs only the turn to its heading: StageTravel).
   struct GoalChoice {
     int goal = -1;
     Eigen::Vector3d stage;
