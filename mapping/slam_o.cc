@@ -218,8 +218,13 @@ void SlamO::UpdateMaps(const std::vector<int>& taken_ids,
   if (obstacles) obstacle_map_.SetObjects(blocking);
 }
 
-int SlamO::ForgetObjectsUnderRobot(double length_m, double width_m) {
+int SlamO::ForgetObjectsUnderRobot(double length_m, double width_m,
+                                   const std::optional<Eigen::Vector3d>& from, double mouth_m) {
   const Eigen::Vector3d pose = ekf_.pose();
+  // The straight way from `from` to here, when the drive covered one.
+  const Eigen::Vector2d way =
+      from ? Eigen::Vector2d(pose.head<2>() - from->head<2>()) : Eigen::Vector2d::Zero();
+  const double way_m = way.norm();
   const Eigen::Matrix2d pose_xy = ekf_.pose_covariance().topLeftCorner<2, 2>();
   const Eigen::Vector2d ahead(std::cos(pose.z()), std::sin(pose.z()));
   const Eigen::Vector2d left(-ahead.y(), ahead.x());
@@ -236,8 +241,23 @@ int SlamO::ForgetObjectsUnderRobot(double length_m, double width_m) {
     }
     const double margin = 2.0 * std::sqrt((pose_xy + o.covariance).trace());
     const Eigen::Vector2d rel = o.position_m - pose.head<2>();
-    return std::abs(rel.dot(ahead)) < length_m / 2.0 - margin &&
-           std::abs(rel.dot(left)) < width_m / 2.0 - margin;
+    const field::ObjectType* type = season_.FindObjectType(o.kind);
+    const double front =
+        length_m / 2.0 + (mouth_m > 0.0 && type ? mouth_m + type->size_m / 2.0 : 0.0);
+    if (rel.dot(ahead) > -(length_m / 2.0 - margin) && rel.dot(ahead) < front - margin &&
+        std::abs(rel.dot(left)) < width_m / 2.0 - margin) {
+      return true;
+    }
+    if (way_m < 0.01 || !type) return false;
+    // Met on the way: the footprint, facing along it (the executive drives its legs straight,
+    // forwards or backwards), from `from` to here, reached the object's edge from the side
+    // (a bumper that meets an object moves it). Not at the front of the last footprint: a
+    // pick or a push stops with the bumper at its object.
+    const Eigen::Vector2d along = way / way_m, side(-along.y(), along.x());
+    const Eigen::Vector2d rel_from = o.position_m - from->head<2>();
+    const double a = rel_from.dot(along);
+    return a > -(length_m / 2.0 - margin) && a < way_m + length_m / 2.0 - margin &&
+           std::abs(rel_from.dot(side)) < width_m / 2.0 + type->size_m / 2.0 - margin;
   });
   forgotten_under_robot_ += forgotten;
   return forgotten;

@@ -142,8 +142,14 @@ class SlamO {
   // forgotten. Under means the object's centre inside the footprint shrunk by two standard
   // deviations of the pose's and the object's position errors; objects within a goal's or a
   // structure's footprint that the robot does not drive over are kept (they may be up on it).
-  // Returns how many were forgotten.
-  int ForgetObjectsUnderRobot(double length_m, double width_m);
+  // Returns how many were forgotten. With `from`, the estimated pose where the drive that
+  // ended here began: objects the footprint swept on the way straight from there are not
+  // where they were believed either (the bumper pushed them along).
+  // With `mouth_m`, the intake's mouth too, that far beyond the front bumper (to the
+  // object's near edge), after a pick that took nothing there.
+  int ForgetObjectsUnderRobot(double length_m, double width_m,
+                              const std::optional<Eigen::Vector3d>& from = std::nullopt,
+                              double mouth_m = 0.0);
 
   // What it believes.
   const EkfSlam& ekf() const { return ekf_; }

@@ -294,6 +294,7 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
     Advance(dt);
     MaybeSnapshot();
   };
+  const Eigen::Vector3d start = slam_.pose();
   const std::vector<platform::DriveStepResult> results =
       platform::RunDriveScript(steps, drive_options_, body);
   if (std::any_of(steps.begin(), steps.end(),
@@ -319,7 +320,8 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
         return r.status == platform::DriveStepStatus::kDone;
       });
   // Not after a blocked step: wheels slipping against an object carry the estimate past it.
-  if (done) slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m);
+  // Objects the footprint met on the way were pushed: not where they were believed.
+  if (done) slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m, start);
   RecordSample();
   return done;
 }
@@ -592,7 +594,14 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   const std::optional<IntakeItem> picked = io_->Pick(target);
   frames_at_rest_ = 0;  // what lay in front of the intake has changed
   Wait(robot_.intake.pick_s);
-  if (!picked) return false;
+  if (!picked) {
+    // Nothing in the intake's mouth: what was believed there is not (the intake's reach and
+    // the robot's width, as SimField::Pick and a real roller intake take).
+    slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m, std::nullopt,
+                                  robot_.intake.reach_m);
+    UpdateMaps();
+    return false;
+  }
   // The intake knows what it took (kind and colour from its own sensor, or taken on trust).
   // Another kind or colour than the target's: the intake took a neighbour, and the target is
   // still on the field (the tracker lets the one taken fade from view).

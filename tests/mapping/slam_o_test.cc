@@ -1,7 +1,9 @@
 // SLAM-O's front end on frames rendered by the simulator, checked against the renderer's truth.
 #include "mapping/slam_o.h"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <gtest/gtest.h>
 
@@ -237,6 +239,80 @@ TEST_F(SlamOTest, ObjectsBelievedUnderTheRobotAreForgotten) {
   EXPECT_EQ(slam.ForgetObjectsUnderRobot(length + 0.2, width + 0.2), 1);
   EXPECT_EQ(slam.ConfirmedObjects().size(), confirmed.size() - 1);
   EXPECT_EQ(slam.forgotten_under_robot(), 1);
+}
+
+// An object the footprint met on the way of the drive that ended here (its centre within
+// half the width plus its radius of the way, less the errors) was pushed along and is
+// forgotten; one beside the way stays. Here the robot came backwards from 1 m beyond the
+// nearest object, along its heading.
+TEST_F(SlamOTest, ObjectsTheFootprintMetOnTheWayAreForgotten) {
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  SlamO slam(season_, robot_.camera, Prior(V(kObjectsView), Eigen::Matrix3d::Identity() * 1e-6),
+             options);
+  slam.TrackObjects(Render(kObjectsView, 0.0), 0.0);
+  slam.TrackObjects(Render(kObjectsView, 0.5), 0.5);
+  const std::vector<TrackedObject> confirmed = slam.ConfirmedObjects();
+  ASSERT_GE(confirmed.size(), 2u);
+  const Eigen::Vector2d at(kObjectsView.x_m, kObjectsView.y_m);
+  const Eigen::Vector2d ahead(std::cos(kObjectsView.theta_rad), std::sin(kObjectsView.theta_rad));
+  const auto side = [&](const TrackedObject& o) {
+    const Eigen::Vector2d rel = o.position_m - at;
+    return std::abs(rel.x() * ahead.y() - rel.y() * ahead.x());
+  };
+  const TrackedObject nearest = *std::min_element(
+      confirmed.begin(), confirmed.end(), [&](const TrackedObject& a, const TrackedObject& b) {
+        return (a.position_m - at).norm() < (b.position_m - at).norm();
+      });
+  const double beyond = (nearest.position_m - at).dot(ahead) + 1.0;
+  const Eigen::Vector3d from(at.x() + beyond * ahead.x(), at.y() + beyond * ahead.y(),
+                             kObjectsView.theta_rad);
+  const double r = season_.FindObjectType(nearest.kind)->size_m / 2.0;
+  const double length = 0.1;  // the footprint where the robot stands covers nothing
+  // A footprint whose side passes 0.1 m short of the object's edge misses it.
+  EXPECT_EQ(slam.ForgetObjectsUnderRobot(length, 2.0 * (side(nearest) - r - 0.1), from), 0);
+  // One whose side reaches 0.15 m past its centre meets it, and every other object it meets.
+  const double width = 2.0 * (side(nearest) + 0.15 - r);
+  int met = 0;
+  for (const TrackedObject& o : confirmed) {
+    const double along = (o.position_m - at).dot(ahead);
+    const double ro = season_.FindObjectType(o.kind)->size_m / 2.0;
+    if (along > -length / 2.0 && along < beyond + length / 2.0 && side(o) < width / 2.0 + ro) ++met;
+  }
+  EXPECT_EQ(slam.ForgetObjectsUnderRobot(length, width, from), met);
+  for (const TrackedObject& o : slam.ConfirmedObjects()) EXPECT_NE(o.id, nearest.id);
+  // Without the way, the same footprint where the robot stands meets nothing.
+  EXPECT_EQ(slam.ForgetObjectsUnderRobot(length, width), 0);
+}
+
+// After a pick that took nothing, what was believed in the intake's mouth (reach_m beyond the
+// front bumper, to the object's near edge) is forgotten; what lies beyond it stays.
+TEST_F(SlamOTest, ObjectsBelievedInAnEmptyIntakeAreForgotten) {
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  SlamO slam(season_, robot_.camera, Prior(V(kObjectsView), Eigen::Matrix3d::Identity() * 1e-6),
+             options);
+  slam.TrackObjects(Render(kObjectsView, 0.0), 0.0);
+  slam.TrackObjects(Render(kObjectsView, 0.5), 0.5);
+  const std::vector<TrackedObject> confirmed = slam.ConfirmedObjects();
+  ASSERT_GE(confirmed.size(), 2u);
+  const Eigen::Vector2d at(kObjectsView.x_m, kObjectsView.y_m);
+  const Eigen::Vector2d ahead(std::cos(kObjectsView.theta_rad), std::sin(kObjectsView.theta_rad));
+  const TrackedObject nearest = *std::min_element(
+      confirmed.begin(), confirmed.end(), [&](const TrackedObject& a, const TrackedObject& b) {
+        return (a.position_m - at).norm() < (b.position_m - at).norm();
+      });
+  const Eigen::Vector2d rel = nearest.position_m - at;
+  const double along = rel.dot(ahead);
+  const double side = std::abs(rel.x() * ahead.y() - rel.y() * ahead.x());
+  const double r = season_.FindObjectType(nearest.kind)->size_m / 2.0;
+  // A robot whose bumper stands 0.1 m short of the object's near edge, wide enough to cover it.
+  const double length = 2.0 * (along - r - 0.1), width = 2.0 * side + 0.4;
+  ASSERT_GT(length, 0.2);
+  EXPECT_EQ(slam.ForgetObjectsUnderRobot(length, width, std::nullopt, 0.0), 0);
+  EXPECT_EQ(slam.ForgetObjectsUnderRobot(length, width, std::nullopt, 0.05), 0);  // short of it
+  EXPECT_GE(slam.ForgetObjectsUnderRobot(length, width, std::nullopt, 0.25), 1);
+  for (const TrackedObject& o : slam.ConfirmedObjects()) EXPECT_NE(o.id, nearest.id);
 }
 
 TEST(OdometryIncrementTest, IsTheMoveInTheFirstPosesFrame) {
