@@ -320,8 +320,15 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
         return r.status == platform::DriveStepStatus::kDone;
       });
   // Not after a blocked step: wheels slipping against an object carry the estimate past it.
-  // Objects the footprint met on the way were pushed: not where they were believed.
-  if (done) slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m, start);
+  // Objects the footprint met on the way were pushed: not where they were believed (on a
+  // drive that goes straight; a turn's slip is no way).
+  const bool straight = std::any_of(steps.begin(), steps.end(), [](const DriveStep& s) {
+    return s.kind == platform::DriveStepKind::kDrive;
+  });
+  if (done) {
+    slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m,
+                                  straight ? std::optional<Eigen::Vector3d>(start) : std::nullopt);
+  }
   RecordSample();
   return done;
 }
@@ -589,16 +596,20 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   const double forward = d.norm() - strategy::PickDistance(robot_, r);
   std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};
   if (std::abs(forward) > 0.01) steps.push_back(Forward(forward / odometry_scale_));
-  Drive(steps);
+  const bool approached = Drive(steps);
   if (now_s() >= deadline_s_) return false;
+  const bool room = !held_;  // a full intake takes nothing, whatever lies in its mouth
   const std::optional<IntakeItem> picked = io_->Pick(target);
   frames_at_rest_ = 0;  // what lay in front of the intake has changed
   Wait(robot_.intake.pick_s);
   if (!picked) {
     // Nothing in the intake's mouth: what was believed there is not (the intake's reach and
-    // the robot's width, as SimField::Pick and a real roller intake take).
-    slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m, std::nullopt,
-                                  robot_.intake.reach_m);
+    // the robot's width, as SimField::Pick and a real roller intake take). Not after a
+    // blocked approach: the wheels slipping carry the estimate past where the robot stands.
+    if (approached && room) {
+      slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m, std::nullopt,
+                                    robot_.intake.reach_m);
+    }
     UpdateMaps();
     return false;
   }

@@ -269,6 +269,7 @@ TEST_F(SlamOTest, ObjectsTheFootprintMetOnTheWayAreForgotten) {
                              kObjectsView.theta_rad);
   const double r = season_.FindObjectType(nearest.kind)->size_m / 2.0;
   const double length = 0.1;  // the footprint where the robot stands covers nothing
+  ASSERT_GT(side(nearest) - r - 0.1, 0.0) << "a footprint of some width misses it";
   // A footprint whose side passes 0.1 m short of the object's edge misses it.
   EXPECT_EQ(slam.ForgetObjectsUnderRobot(length, 2.0 * (side(nearest) - r - 0.1), from), 0);
   // One whose side reaches 0.15 m past its centre meets it, and every other object it meets.
