@@ -37,6 +37,18 @@ double ObjectRadius(const field::SeasonConfig& season, const std::string& kind) 
   return type ? type->size_m / 2.0 : 0.1;
 }
 
+// Half a goal's footprint (a cylinder's radius, a box's narrower half-size).
+double GoalHalf(const field::Goal& g) {
+  return g.shape == field::SolidShape::kCylinder ? g.radius_m
+                                                 : 0.5 * std::min(g.size_m.x, g.size_m.y);
+}
+
+// Whether structure s is goal g's own (its frame: the structure's centre within the goal's
+// half).
+bool OwnStructure(const field::Goal& g, const field::Structure& s) {
+  return std::hypot(s.center_m.x - g.center_m.x, s.center_m.y - g.center_m.y) < GoalHalf(g);
+}
+
 bool InGoalStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p) {
   for (const field::Goal& g : season.goals) {
     if (g.kind == field::GoalKind::kGoal && platform::GoalContains(g, p)) return true;
@@ -250,9 +262,7 @@ class Base : public Strategy {
     }
     // A goal structure forgives its half-width across the way in less the drop's offset (a
     // box's radius_m is 0: its narrower half-size); a zone forgives more.
-    const double half = g.shape == field::SolidShape::kCylinder
-                            ? g.radius_m
-                            : 0.5 * std::min(g.size_m.x, g.size_m.y);
+    const double half = GoalHalf(g);
     const double tolerance = g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * half) : 0.3;
     const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() *
                                 (PoseVarianceAfter(b, frames) + b.pose_covariance(2, 2) * 0.25);
@@ -270,13 +280,21 @@ class Base : public Strategy {
     return 0.5 * (g.size_m.x * std::abs(std::sin(rel)) + g.size_m.y * std::abs(std::cos(rel)));
   }
 
-  // Whether a goal is a structure raised off the floor (objects lower than it pass under).
+  // Whether a goal is a structure raised off the floor (objects lower than it pass under): the
+  // structure of the goal's name, else (a frame named apart, as Over Under's goal frames) its
+  // own structures, when one is raised and none blocks the robot. A stake on an object is not.
   static bool RaisedGoal(const field::SeasonConfig& season, const field::Goal* goal) {
-    if (!goal || goal->kind != field::GoalKind::kGoal) return false;
+    if (!goal || goal->kind != field::GoalKind::kGoal || !goal->on_object.empty()) return false;
     for (const field::Structure& s : season.structures) {
       if (s.name == goal->name) return s.PassUnder();
     }
-    return false;
+    bool raised = false;
+    for (const field::Structure& s : season.structures) {
+      if (!OwnStructure(*goal, s)) continue;
+      if (s.blocks_robot) return false;
+      raised = raised || s.PassUnder();
+    }
+    return raised;
   }
 
   // Whether the final straight approach from `stage` over `length_m` is free of known
@@ -1434,20 +1452,16 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
   }
   if (g.kind == field::GoalKind::kGoal) {
     // Bumper just short of the goal's edge; the drop then lands inside it.
-    const double half = g.shape == field::SolidShape::kCylinder
-                            ? g.radius_m
-                            : 0.5 * std::min(g.size_m.x, g.size_m.y);
+    const double half = GoalHalf(g);
     const double reach = half + robot.length_m / 2.0 + 0.015;
     if (std::abs(reach - ReleaseDistance(robot, object_radius_m)) > half) return out;
     // The robot at the release must not overlap anything but the goal's own structure (a goal
     // against a barrier is reached from its open side only).
     field::SeasonConfig others = *context.season;
-    others.structures.erase(std::remove_if(others.structures.begin(), others.structures.end(),
-                                           [&](const field::Structure& st) {
-                                             return std::hypot(st.center_m.x - centre.x(),
-                                                               st.center_m.y - centre.y()) < half;
-                                           }),
-                            others.structures.end());
+    others.structures.erase(
+        std::remove_if(others.structures.begin(), others.structures.end(),
+                       [&](const field::Structure& st) { return OwnStructure(g, st); }),
+        others.structures.end());
     for (int k = 0; k < 12; ++k) {
       const double heading = k * kPi / 6.0;
       const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));

@@ -602,6 +602,36 @@ TEST_F(StrategyTest, ABlockAheadIsPushedUnderARaisedGoal) {
             ActionKind::kScore);
 }
 
+// The same under a goal whose raised frame is a structure of another name (Over Under's goal
+// nets, `red_goal_frame`, 0.16 m up, over 0.157 m triballs): a triball straight ahead of the
+// release is pushed in under the front bar. Only the structure named as the goal counted, and
+// in the disturbed layout triballs in front of the goal sent the planner to release its preload
+// over the barrier into the offensive zone instead (2 points for 5).
+TEST_F(StrategyTest, ATriballAheadIsPushedUnderAGoalFrameOfAnotherName) {
+  Use("over_under", "v5_drivetrain");
+  ASSERT_TRUE(OnlyGoal("red_goal"));
+  const double r = 0.5 * season_.FindObjectType("triball")->size_m;
+  const std::vector<Eigen::Vector3d> stages = ScoreStages(context_, 0, r, 0.15);
+  ASSERT_FALSE(stages.empty());
+  const Eigen::Vector3d stage = stages.front();
+  const Eigen::Vector2d ahead =
+      stage.head<2>() + 0.3 * Eigen::Vector2d(std::cos(stage.z()), std::sin(stage.z()));
+  const ObjectBelief triball{9, "triball", "green", ahead, Eigen::Matrix2d::Identity() * 1e-4, 1.0};
+  const Action alone = FirstHolding(stage, {}, 14.7, true, StrategyOptions{}, "triball");
+  ASSERT_EQ(alone.kind, ActionKind::kScore) << alone.why;
+  const Action with = FirstHolding(stage, {triball}, 14.7, true, StrategyOptions{}, "triball");
+  EXPECT_EQ(with.kind, ActionKind::kScore) << with.why;
+  // A frame that blocks the robot is no goal to push under: the same triball closes the way.
+  for (field::Structure& s : season_.structures) {
+    if (s.name == "red_goal_frame") s.blocks_robot = true;
+  }
+  ResetMap();
+  const Action free = FirstHolding(stage, {}, 14.7, true, StrategyOptions{}, "triball");
+  ASSERT_EQ(free.kind, ActionKind::kScore) << free.why;
+  const Action blocked = FirstHolding(stage, {triball}, 14.7, true, StrategyOptions{}, "triball");
+  EXPECT_NE(blocked.kind, ActionKind::kScore) << blocked.why;
+}
+
 // Standing a few centimetres off a pick's stage, the robot picks from where it is (the pick
 // turns and drives the rest itself): the cycle is timed as from the stage, with the turn to
 // its heading. Timed with the travel field it carried three settles even at the stage itself
