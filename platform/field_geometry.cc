@@ -100,6 +100,41 @@ bool GoalTakes(const field::Goal& goal, const Eigen::Vector2d& drop, double head
   return false;
 }
 
+double GoalHalfSize(const field::Goal& goal) {
+  return goal.shape == SolidShape::kCylinder ? goal.radius_m
+                                             : 0.5 * std::min(goal.size_m.x, goal.size_m.y);
+}
+
+bool IsGoalStructure(const field::Goal& goal, const field::Structure& s) {
+  return std::hypot(s.center_m.x - goal.center_m.x, s.center_m.y - goal.center_m.y) <
+         GoalHalfSize(goal);
+}
+
+bool GoalIsRaised(const SeasonConfig& season, const field::Goal& goal) {
+  if (goal.kind != field::GoalKind::kGoal || !goal.on_object.empty()) return false;
+  for (const Structure& s : season.structures) {
+    if (s.name == goal.name) return s.PassUnder();
+  }
+  bool raised = false;
+  for (const Structure& s : season.structures) {
+    if (!IsGoalStructure(goal, s)) continue;
+    if (s.blocks_robot) return false;
+    raised = raised || s.PassUnder();
+  }
+  return raised;
+}
+
+int GoalPushedInto(const SeasonConfig& season, const Eigen::Vector2d& p) {
+  for (size_t g = 0; g < season.goals.size(); ++g) {
+    const field::Goal& goal = season.goals[g];
+    if (goal.entry != field::Goal::Entry::kEnds && GoalContains(goal, p) &&
+        GoalIsRaised(season, goal)) {
+      return static_cast<int>(g);
+    }
+  }
+  return -1;
+}
+
 double CarrierRadius(const SeasonConfig& season, const field::Goal& goal) {
   if (goal.on_object.empty()) return 0.0;
   const field::ObjectType* type = season.FindObjectType(goal.on_object);

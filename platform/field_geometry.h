@@ -54,6 +54,24 @@ inline constexpr double kEntryAngle_deg = 30.0;
 bool GoalTakes(const field::Goal& goal, const Eigen::Vector2d& drop, double heading_rad,
                double object_size_m);
 
+// Half a goal's footprint: a cylinder's radius, a box's narrower half-size.
+double GoalHalfSize(const field::Goal& goal);
+
+// Whether structure s is goal g's own (its frame): the structure's centre within
+// GoalHalfSize of the goal's.
+bool IsGoalStructure(const field::Goal& goal, const field::Structure& s);
+
+// Whether a goal structure is raised off the floor, objects lower than its underside passing
+// in under it (Over Under's nets, Push Back's upper centre goal): the structure of the goal's
+// name, else (a frame named apart) its own structures, when one is raised and none blocks the
+// robot. A stake on an object is not.
+bool GoalIsRaised(const field::SeasonConfig& season, const field::Goal& goal);
+
+// The goal an object on the floor counts in when pushed to p (not released there): a raised
+// goal (GoalIsRaised) entered from any side (not a tube), p inside its footprint; -1 for none.
+// (Whether the object fits under is PointBlocksObject's question, asked before it moves.)
+int GoalPushedInto(const field::SeasonConfig& season, const Eigen::Vector2d& p);
+
 // The radius of the object a goal stands on (Goal::on_object; 0 for a fixed goal).
 double CarrierRadius(const field::SeasonConfig& season, const field::Goal& goal);
 

@@ -37,18 +37,6 @@ double ObjectRadius(const field::SeasonConfig& season, const std::string& kind) 
   return type ? type->size_m / 2.0 : 0.1;
 }
 
-// Half a goal's footprint (a cylinder's radius, a box's narrower half-size).
-double GoalHalf(const field::Goal& g) {
-  return g.shape == field::SolidShape::kCylinder ? g.radius_m
-                                                 : 0.5 * std::min(g.size_m.x, g.size_m.y);
-}
-
-// Whether structure s is goal g's own (its frame: the structure's centre within the goal's
-// half).
-bool OwnStructure(const field::Goal& g, const field::Structure& s) {
-  return std::hypot(s.center_m.x - g.center_m.x, s.center_m.y - g.center_m.y) < GoalHalf(g);
-}
-
 bool InGoalStructure(const field::SeasonConfig& season, const Eigen::Vector2d& p) {
   for (const field::Goal& g : season.goals) {
     if (g.kind == field::GoalKind::kGoal && platform::GoalContains(g, p)) return true;
@@ -262,7 +250,7 @@ class Base : public Strategy {
     }
     // A goal structure forgives its half-width across the way in less the drop's offset (a
     // box's radius_m is 0: its narrower half-size); a zone forgives more.
-    const double half = GoalHalf(g);
+    const double half = platform::GoalHalfSize(g);
     const double tolerance = g.kind == field::GoalKind::kGoal ? std::max(0.03, 0.6 * half) : 0.3;
     const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() *
                                 (PoseVarianceAfter(b, frames) + b.pose_covariance(2, 2) * 0.25);
@@ -280,21 +268,9 @@ class Base : public Strategy {
     return 0.5 * (g.size_m.x * std::abs(std::sin(rel)) + g.size_m.y * std::abs(std::cos(rel)));
   }
 
-  // Whether a goal is a structure raised off the floor (objects lower than it pass under): the
-  // structure of the goal's name, else (a frame named apart, as Over Under's goal frames) its
-  // own structures, when one is raised and none blocks the robot. A stake on an object is not.
+  // Whether a goal is a structure raised off the floor (objects lower than it pass under).
   static bool RaisedGoal(const field::SeasonConfig& season, const field::Goal* goal) {
-    if (!goal || goal->kind != field::GoalKind::kGoal || !goal->on_object.empty()) return false;
-    for (const field::Structure& s : season.structures) {
-      if (s.name == goal->name) return s.PassUnder();
-    }
-    bool raised = false;
-    for (const field::Structure& s : season.structures) {
-      if (!OwnStructure(*goal, s)) continue;
-      if (s.blocks_robot) return false;
-      raised = raised || s.PassUnder();
-    }
-    return raised;
+    return goal && platform::GoalIsRaised(season, *goal);
   }
 
   // Whether the final straight approach from `stage` over `length_m` is free of known
@@ -581,8 +557,14 @@ class Base : public Strategy {
     const double half = c.season->HalfSize();
     const double reach = c.robot->length_m / 2.0 + r;  // robot centre to object centre, touching
     for (int g = 0; g < static_cast<int>(c.season->goals.size()); ++g) {
+      // Into a floor zone, or in under a raised goal's frame (the simulator's SimField::PushOut
+      // counts it scored there).
       const field::Goal& zone = c.season->goals[g];
-      if (zone.kind != field::GoalKind::kZone || zone.shape != field::SolidShape::kBox) continue;
+      if (zone.shape != field::SolidShape::kBox) continue;
+      if (zone.kind != field::GoalKind::kZone &&
+          (zone.entry == field::Goal::Entry::kEnds || !platform::GoalIsRaised(*c.season, zone))) {
+        continue;
+      }
       const int points = GoalPoints(*c.season, g, o.kind, o.colour, c.alliance);
       if (points <= before) continue;
       // The nearest point of the zone shrunk by the object's radius and kPushInside_m.
@@ -1452,16 +1434,17 @@ std::vector<Eigen::Vector3d> ScoreStages(const StrategyContext& context, int goa
   }
   if (g.kind == field::GoalKind::kGoal) {
     // Bumper just short of the goal's edge; the drop then lands inside it.
-    const double half = GoalHalf(g);
+    const double half = platform::GoalHalfSize(g);
     const double reach = half + robot.length_m / 2.0 + 0.015;
     if (std::abs(reach - ReleaseDistance(robot, object_radius_m)) > half) return out;
     // The robot at the release must not overlap anything but the goal's own structure (a goal
     // against a barrier is reached from its open side only).
     field::SeasonConfig others = *context.season;
-    others.structures.erase(
-        std::remove_if(others.structures.begin(), others.structures.end(),
-                       [&](const field::Structure& st) { return OwnStructure(g, st); }),
-        others.structures.end());
+    others.structures.erase(std::remove_if(others.structures.begin(), others.structures.end(),
+                                           [&](const field::Structure& st) {
+                                             return platform::IsGoalStructure(g, st);
+                                           }),
+                            others.structures.end());
     for (int k = 0; k < 12; ++k) {
       const double heading = k * kPi / 6.0;
       const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));

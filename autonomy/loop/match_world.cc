@@ -647,9 +647,7 @@ bool MatchWorld::Score(const strategy::Action& action) {
   if (goal.kind == field::GoalKind::kGoal) {
     const double half = goal.entry == field::Goal::Entry::kEnds ? 0.0
                         : !goal.on_object.empty() ? platform::CarrierRadius(field_, goal)
-                        : goal.shape == field::SolidShape::kCylinder
-                            ? goal.radius_m
-                            : 0.5 * std::min(goal.size_m.x, goal.size_m.y);
+                                                  : platform::GoalHalfSize(goal);
     forward = d.norm() - (half + robot_.length_m / 2.0 + 0.015);
   }
   std::vector<DriveStep> steps = {Turn(turn * 180.0 / kPi)};

@@ -249,7 +249,12 @@ bool SimField::CanPushOut(const Pose2D& pose, double length_m, double width_m,
 void SimField::PushOut(const Pose2D& pose, double length_m, double width_m, double height_m) {
   for (SimObject& o : world_.objects) {
     if (!Pushable(season_, o, height_m)) continue;
-    if (const auto p = PushedPosition(o, pose, length_m, width_m)) o.center_m.head<2>() = *p;
+    if (const auto p = PushedPosition(o, pose, length_m, width_m)) {
+      o.center_m.head<2>() = *p;
+      // Pushed along the floor in under a raised goal's frame (Over Under's nets), it is in
+      // the goal, as a released one: scored, and no longer pushed about.
+      if (OnFloor(o)) o.in_goal = GoalPushedInto(season_, *p);
+    }
   }
 }
 

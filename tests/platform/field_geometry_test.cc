@@ -56,6 +56,43 @@ bool FootprintIsFreeReference(const field::SeasonConfig& season, const Pose2D& p
 
 // The fast test (structures out of reach skipped, rotations worked out once) gives the plain
 // test's answer everywhere, on every season, for robots that pass under barriers and not.
+// Which goals objects are pushed in under: Over Under's nets (frames named apart from their
+// goals, 0.16 m up), Push Back's upper centre goal (a tube: entered through its ends only, so
+// nothing is pushed into it); not goals whose own structure blocks robots.
+TEST(GoalTest, RaisedGoalsAreThoseObjectsPassUnder) {
+  const auto raised = [](const std::string& season_name, const std::string& goal) {
+    const field::SeasonConfig season = field::LoadSeasonConfig(season_name);
+    for (const field::Goal& g : season.goals) {
+      if (g.name == goal) return GoalIsRaised(season, g);
+    }
+    ADD_FAILURE() << season_name << " has no goal " << goal;
+    return false;
+  };
+  EXPECT_TRUE(raised("over_under", "red_goal"));
+  EXPECT_TRUE(raised("over_under", "blue_goal"));
+  EXPECT_FALSE(raised("over_under", "red_offensive_zone"));
+  EXPECT_TRUE(raised("push_back", "center_goal_upper"));
+  EXPECT_FALSE(raised("push_back", "center_goal_lower"));
+  EXPECT_FALSE(raised("push_back", "long_goal_left"));
+  EXPECT_FALSE(raised("toss_up", "red_stash"));
+  EXPECT_FALSE(raised("nothing_but_net", "red_low_goal"));
+  EXPECT_FALSE(raised("high_stakes", "neutral_stake_left"));
+
+  const field::SeasonConfig over_under = field::LoadSeasonConfig("over_under");
+  const auto index = [](const field::SeasonConfig& season, const std::string& goal) {
+    for (size_t g = 0; g < season.goals.size(); ++g) {
+      if (season.goals[g].name == goal) return static_cast<int>(g);
+    }
+    return -2;
+  };
+  EXPECT_EQ(GoalPushedInto(over_under, Eigen::Vector2d(1.30, 0.1)), index(over_under, "red_goal"));
+  EXPECT_EQ(GoalPushedInto(over_under, Eigen::Vector2d(-1.30, 0.0)),
+            index(over_under, "blue_goal"));
+  EXPECT_EQ(GoalPushedInto(over_under, Eigen::Vector2d(1.0, 0.0)), -1);  // in front of the bar
+  const field::SeasonConfig push_back = field::LoadSeasonConfig("push_back");
+  EXPECT_EQ(GoalPushedInto(push_back, Eigen::Vector2d(0.0, 0.0)), -1);  // tubes: ends only
+}
+
 TEST(FootprintTest, AgreesWithPointByPointTest) {
   std::mt19937_64 rng(17);
   for (const std::string& name : field::ListSeasons()) {

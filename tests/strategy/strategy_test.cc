@@ -632,6 +632,27 @@ TEST_F(StrategyTest, ATriballAheadIsPushedUnderAGoalFrameOfAnotherName) {
   EXPECT_NE(blocked.kind, ActionKind::kScore) << blocked.why;
 }
 
+// A triball on the floor in front of an Over Under goal is pushed in under the front bar (the
+// simulator counts it in the goal, SimField::PushOut): 5 points for the 2 it earns in the
+// offensive zone, without a pick. Floor pushes went into floor zones only.
+TEST_F(StrategyTest, ATriballIsPushedInUnderARaisedGoalsBar) {
+  Use("over_under", "v5_drivetrain");
+  const ObjectBelief triball{
+      7, "triball", "green", Eigen::Vector2d(0.80, 0.10), Eigen::Matrix2d::Identity() * 1e-4, 1.0};
+  StrategyOptions options;
+  options.raised_priors = false;
+  const Action a =
+      FirstHolding(Eigen::Vector3d(0.20, 0.10, 0.0), {triball}, 4.0, false, options, "triball");
+  ASSERT_EQ(a.kind, ActionKind::kNavigate) << a.why;
+  EXPECT_EQ(a.object_id, 7) << a.why;
+  EXPECT_TRUE(a.along_floor) << a.why;
+  EXPECT_EQ(a.goal_index, Goal("red_goal")) << a.why;
+  options.floor_pushes = false;
+  const Action off =
+      FirstHolding(Eigen::Vector3d(0.20, 0.10, 0.0), {triball}, 4.0, false, options, "triball");
+  EXPECT_FALSE(off.kind == ActionKind::kNavigate && off.along_floor) << off.why;
+}
+
 // Standing a few centimetres off a pick's stage, the robot picks from where it is (the pick
 // turns and drives the rest itself): the cycle is timed as from the stage, with the turn to
 // its heading. Timed with the travel field it carried three settles even at the stage itself

@@ -554,12 +554,12 @@ TEST(Executive, APickOrReleaseLooksOnlyWhenTheSceneChangedSinceTheLastLook) {
   EXPECT_GT(frames_of(strategy::ActionKind::kPick, Before::kDrop), 0);
 }
 
-// Over Under seed 6 with the V5 robot: after its preload the planner sets off to push a far
-// green triball into our offensive zone, and the drive carries a green triball lying in that
-// zone across the centre line (2 points lost). Charged for that loss, the sequence is not
-// worth it. (Over seeds 1-30 nominal, `--param push_loss=0,1`: 4.73 -> 5.33 gained, no seed
-// worse, at e453a17; then seed 14 showed it, which later timing changes turned away from the
-// push on their own.)
+// Over Under seed 22 with the V5 robot: after its preload the planner sets off to push a far
+// green triball, and the drive carries a green triball lying in our offensive zone out of it
+// (2 points lost). Charged for that loss, the sequence is not worth it. (Over seeds 1-30
+// nominal, `--param push_loss=0,1`: 4.73 -> 5.33 gained, no seed worse, at e453a17; then seed
+// 14 showed it, which later timing changes turned away from the push on their own, then seed
+// 6, which pushes under the goals' bars turned to another push that loses nothing.)
 TEST(Executive, ADriveThatWouldPushOurTriballOutOfItsZoneIsNotTaken) {
   const field::SeasonConfig season = field::LoadSeasonConfig("over_under");
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
@@ -567,7 +567,7 @@ TEST(Executive, ADriveThatWouldPushOurTriballOutOfItsZoneIsNotTaken) {
     MatchSetup setup;
     setup.strategy = "planner";
     setup.strategy_options.count_push_loss = count;
-    const MatchResult r = RunMatch(season, robot, setup, 6);
+    const MatchResult r = RunMatch(season, robot, setup, 22);
     EXPECT_EQ(r.overrun_s, 0.0);
     return r.points - r.points_start;
   };

@@ -208,6 +208,39 @@ TEST(SimFieldPushBackTest, ABlockGoesIntoALongGoalThroughItsEndOnly) {
   EXPECT_EQ(released->points, 3);
 }
 
+// Over Under: a triball pushed along the floor in under a goal's front bar (the frame 0.16 m
+// up, a triball 0.157 m tall) is in the goal and scores 5, as a released one; the robot, taller
+// than the bar, stops at it. Before, only a release put anything in a goal, and the triballs
+// the robot pushed under the net still counted as lying in the offensive zone (2).
+TEST(SimFieldOverUnderTest, ATriballPushedUnderTheGoalsBarIsInTheGoal) {
+  field::SeasonConfig season = field::LoadSeasonConfig("over_under");
+  season.objects.clear();
+  season.opponents.clear();
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  field::ObjectPlacement p;
+  p.type = "triball";
+  p.colour = "green";
+  p.position_m = field::Vec2{0.85, 0.05};
+  season.objects.push_back(p);
+  SimField field(season, robot, Alliance::kRed, 1, Pose2D{0.35, 0.05, 0.0});
+  EXPECT_EQ(field.Score(Alliance::kRed), 2);  // in the red offensive zone
+  SimClock clock;
+  RunDriveScript(ParseDriveScript("forward 0.9"), DriveControllerOptionsFor(robot.drive),
+                 &field.drive(), &clock, [&field](double dt) { field.Step(dt); });
+  const SimObject& triball = field.world().objects[0];
+  EXPECT_GT(triball.center_m.x(), 1.19);  // past the front bar
+  EXPECT_GE(triball.in_goal, 0);
+  EXPECT_EQ(field.Score(Alliance::kRed), 5);
+  EXPECT_EQ(field.Score(Alliance::kBlue), 0);
+  EXPECT_LT(field.robot_pose().x_m + robot.length_m / 2.0, 1.19 + 0.01);  // stopped at the bar
+  // In the goal it is not pushed about any more: backing off leaves it there.
+  const Eigen::Vector3d in = triball.center_m;
+  RunDriveScript(ParseDriveScript("back 0.3"), DriveControllerOptionsFor(robot.drive),
+                 &field.drive(), &clock, [&field](double dt) { field.Step(dt); });
+  EXPECT_EQ((field.world().objects[0].center_m - in).norm(), 0.0);
+  EXPECT_EQ(field.Score(Alliance::kRed), 5);
+}
+
 // High Stakes: a mobile goal's stake stands on its base and moves with it (on_object). A ring
 // released with the bumper at the base, the stake within the intake's reach, goes onto the
 // stake and scores 1, wherever the goal has been pushed to; before, the stakes stayed at the
