@@ -386,6 +386,22 @@ class Base : public Strategy {
   // within half the robot's width of its line, is carried to the bumper's end of the drive;
   // what it earns there is subtracted. (The planner's path is the straight line unless an
   // obstacle bends it.)
+  // Whether the straight drive from `from` to `to` pushes object o (one it may push, not an
+  // obstacle on the planner's map, met within half the robot's width of its line).
+  static bool OnTheWay(const StrategyContext& c, const Eigen::Vector3d& from,
+                       const Eigen::Vector3d& to, const ObjectBelief& o) {
+    const Eigen::Vector2d d = to.head<2>() - from.head<2>();
+    const double length = d.norm();
+    if (length < 0.05 || !c.is_clear(o.position_m)) return false;
+    const Eigen::Vector2d dir = d / length;
+    const double r = ObjectRadius(*c.season, o.kind);
+    const Eigen::Vector2d rel = o.position_m - from.head<2>();
+    const double along = rel.dot(dir);
+    const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
+    return along > 0.0 && along < length + c.robot->length_m / 2.0 &&
+           side < c.robot->width_m / 2.0 + r;
+  }
+
   double PushLoss(const Belief& b, const StrategyContext& c, const Eigen::Vector3d& from,
                   const Eigen::Vector3d& to) const {
     const Eigen::Vector2d d = to.head<2>() - from.head<2>();
@@ -394,17 +410,11 @@ class Base : public Strategy {
     const Eigen::Vector2d dir = d / length;
     double loss = 0.0;
     for (const ObjectBelief& o : b.objects) {
-      if (!c.is_clear(o.position_m)) continue;  // an obstacle: driven round
+      if (!OnTheWay(c, from, to, o)) continue;
       const int now = FloorPoints(*c.season, o.position_m, o.kind, o.colour, c.alliance);
       if (now <= 0) continue;
       const double r = ObjectRadius(*c.season, o.kind);
-      const Eigen::Vector2d rel = o.position_m - from.head<2>();
-      const double along = rel.dot(dir);
-      const double side = std::abs(rel.x() * dir.y() - rel.y() * dir.x());
-      if (along <= 0.0 || along >= length + c.robot->length_m / 2.0 ||
-          side >= c.robot->width_m / 2.0 + r) {
-        continue;
-      }
+      const double along = (o.position_m - from.head<2>()).dot(dir);
       const Eigen::Vector2d carried = to.head<2>() + (c.robot->length_m / 2.0 + r) * dir +
                                       (o.position_m - from.head<2>() - along * dir);
       const int then = FloorPoints(*c.season, carried, o.kind, o.colour, c.alliance);
@@ -1027,8 +1037,11 @@ class PlannerStrategy : public Base {
         if (options_.horizon < 2) continue;
         // The second cycle from where the first ends, with no extra observation; its travel
         // from the first's goal is the planner's, like the first's.
+        const Eigen::Vector3d& first_stage = first.object ? first.pick_stage : first.score_stage;
         for (const ObjectBelief& o : b.objects) {
           if (first.object && o.id == first.object->id) continue;
+          // What the first drive pushes on is no longer where the second would find it.
+          if (options_.count_push_loss && OnTheWay(c, b.pose, first_stage, o)) continue;
           for (const Cycle& second : ObjectCycles(b, c, o, first.score_stage, 0)) {
             if (first.object && second.object && second.object->id == first.object->id) continue;
             consider(first,

@@ -128,7 +128,8 @@ struct StrategyOptions {
   bool floor_pushes = true;
   double max_floor_push_m = 1.0;
   // Planner: a sequence's value loses the points of our objects the drive to its first stage
-  // would push out of the zones they earn in (strategy.cc, Base::PushLoss).
+  // would push out of the zones they earn in (strategy.cc, Base::PushLoss), and its second
+  // cycle is not planned on an object that drive pushes on (Base::OnTheWay).
   bool count_push_loss = true;
   // Time cycles with the drive, pick and release estimates scaled by how long those actions
   // took so far in the match (strategy.cc, Base::Scale).

@@ -74,7 +74,8 @@ const std::map<std::string, std::string>& TunableParams() {
       {"arrival_fixes", "look-and-correct rounds on arrival"},
       {"floor_push", "1: objects on the floor may be pushed into a zone that pays more; 0: never"},
       {"push_loss",
-       "planner: 1 counts against a sequence what its first drive pushes out of our zones; 0: not"},
+       "planner: 1 counts against a sequence what its first drive pushes out of our zones, and "
+       "plans no second cycle on what that drive pushes on; 0: neither"},
       {"reverse_max",
        "path legs behind the robot up to this long (m) are driven backwards (0: never)"},
       {"pushable", "objects narrower than this fraction of the robot are pushed, not avoided"},
