@@ -560,20 +560,23 @@ TEST(Executive, APickOrReleaseLooksOnlyWhenTheSceneChangedSinceTheLastLook) {
 // nominal, `--param push_loss=0,1`: 4.73 -> 5.33 gained, no seed worse, at e453a17; then seed
 // 14 showed it, which later timing changes turned away from the push on their own, then seed
 // 6, which pushes under the goals' bars turned to another push that loses nothing.)
-TEST(Executive, ADriveThatWouldPushOurTriballOutOfItsZoneIsNotTaken) {
-  const field::SeasonConfig season = field::LoadSeasonConfig("over_under");
+// Points the planner gains on `season` with the V5 robot, seed `seed`, with the push-loss rules
+// on or off (StrategyOptions::count_push_loss); no overrun either way.
+int GainedWithPushLoss(const std::string& season_name, uint64_t seed, bool count) {
+  const field::SeasonConfig season = field::LoadSeasonConfig(season_name);
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
-  const auto gained = [&](bool count) {
-    MatchSetup setup;
-    setup.strategy = "planner";
-    setup.strategy_options.count_push_loss = count;
-    const MatchResult r = RunMatch(season, robot, setup, 22);
-    EXPECT_EQ(r.overrun_s, 0.0);
-    return r.points - r.points_start;
-  };
-  const int without = gained(false), with = gained(true);
-  EXPECT_EQ(without, 3);  // the preload's 5, less the triball pushed out
-  EXPECT_EQ(with, 5);
+  MatchSetup setup;
+  setup.strategy = "planner";
+  setup.strategy_options.count_push_loss = count;
+  const MatchResult r = RunMatch(season, robot, setup, seed);
+  EXPECT_EQ(r.overrun_s, 0.0);
+  return r.points - r.points_start;
+}
+
+TEST(Executive, ADriveThatWouldPushOurTriballOutOfItsZoneIsNotTaken) {
+  // The preload's 5, less the triball pushed out; then the preload's 5.
+  EXPECT_EQ(GainedWithPushLoss("over_under", 22, false), 3);
+  EXPECT_EQ(GainedWithPushLoss("over_under", 22, true), 5);
 }
 
 // The second cycle of a sequence is not planned on objects the first one's drive pushes on.
@@ -584,18 +587,8 @@ TEST(Executive, ADriveThatWouldPushOurTriballOutOfItsZoneIsNotTaken) {
 // for the second cycle, as the scripted route does it: 6. (Blocks on the floor earn nothing
 // where they lie, so `count_push_loss` changes nothing else here.)
 TEST(Executive, TheSecondCycleIsNotPlannedOnWhatTheFirstDrivePushesAway) {
-  const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
-  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
-  const auto gained = [&](bool count) {
-    MatchSetup setup;
-    setup.strategy = "planner";
-    setup.strategy_options.count_push_loss = count;
-    const MatchResult r = RunMatch(season, robot, setup, 1);
-    EXPECT_EQ(r.overrun_s, 0.0);
-    return r.points - r.points_start;
-  };
-  EXPECT_EQ(gained(false), 3);
-  EXPECT_EQ(gained(true), 6);
+  EXPECT_EQ(GainedWithPushLoss("push_back", 1, false), 3);
+  EXPECT_EQ(GainedWithPushLoss("push_back", 1, true), 6);
 }
 
 // The release takes the robot file's time: the same release with a quicker intake ends that
