@@ -328,6 +328,20 @@ class Base : public Strategy {
     return true;
   }
 
+  // The final approach of a pick from `stage`, as far as the intake still takes the object
+  // (the bumper its reach short of the object's near edge), overlaps nothing fixed: the
+  // perimeter, a goal's end beside the object. A robot that meets a structure sooner stops
+  // short, its wheels slipping, and the intake takes nothing (Push Back's blocks beside a long
+  // goal's end); from another side the approach may be free.
+  bool ApproachIsFree(const StrategyContext& c, const Eigen::Vector3d& stage) const {
+    const double to_go_m = options_.approach_margin_m - c.robot->intake.reach_m / 2.0;
+    const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
+    const Eigen::Vector2d mid = stage.head<2>() + 0.5 * to_go_m * dir;
+    return platform::FootprintIsFree(*c.season, platform::Pose2D{mid.x(), mid.y(), stage.z()},
+                                     c.robot->length_m + to_go_m, c.robot->width_m,
+                                     c.robot->height_m);
+  }
+
   // ScoreStages for goal g and an object of radius r. They depend only on the season, the robot
   // and the planner's map, none of which changes during a decision, while a decision asks for
   // them for every candidate cycle: computed once per decision (Next() forgets them).
@@ -691,7 +705,8 @@ class Base : public Strategy {
     std::optional<Eigen::Vector3d> stage =
         PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m,
                   [&](const Eigen::Vector3d& s) {
-                    return CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
+                    return ApproachIsFree(c, s) &&
+                           CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
                   });
     if (!stage) return out;
     const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
@@ -712,7 +727,8 @@ class Base : public Strategy {
       const Eigen::Vector2d at =
           t_o.position_m - (PickDistance(*c.robot, r) + options_.approach_margin_m) * dir;
       stage = Eigen::Vector3d(at.x(), at.y(), stage->z());
-      if (!c.is_clear(at) || !CorridorFree(b, c, *stage, corridor, t_o.id, 0.0, nullptr, same))
+      if (!c.is_clear(at) || !ApproachIsFree(c, *stage) ||
+          !CorridorFree(b, c, *stage, corridor, t_o.id, 0.0, nullptr, same))
         return out;
     }
     if (failed_targets_.count(Key(*stage))) return out;

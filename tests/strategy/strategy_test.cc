@@ -813,6 +813,34 @@ TEST_F(StrategyTest, AGroupOfOurBlocksIsPickedFromTheBlockNearestTheBumper) {
   EXPECT_FALSE(blue_in_the_way) << m.why << ": heading " << m.target.z() * 180.0 / M_PI;
 }
 
+// A block just beside a long goal's end, the robot before that end (Push Back disturbed seed
+// 94): turned straight at the block from here, the robot's corner meets the goal's end before
+// the intake reaches the block, and the pick takes nothing. The pick chosen is approached from
+// where the robot's footprint stays clear of the goal until the intake reaches its target.
+TEST_F(StrategyTest, APickIsNotApproachedThroughAStructure) {
+  Use("push_back", "v5_drivetrain");
+  const Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() * 1e-4;
+  const std::vector<ObjectBelief> block = {{1, "block", "red", {-0.566, 1.000}, cov, 1.0}};
+  const Eigen::Vector3d pose(-1.01, 1.20, 0.0);
+  const Action a = FirstHolding(pose, block, 8.5, /*held=*/false);
+  ASSERT_TRUE(a.kind == ActionKind::kNavigate || a.kind == ActionKind::kPick) << a.why;
+  ASSERT_EQ(a.object_id, 1) << a.why;
+  const Eigen::Vector2d from = a.kind == ActionKind::kNavigate ? Eigen::Vector2d(a.target.head<2>())
+                                                               : Eigen::Vector2d(pose.head<2>());
+  const Eigen::Vector2d dir(std::cos(a.target.z()), std::sin(a.target.z()));
+  // Where the bumper is the intake's reach short of the block's near edge.
+  const double r = season_.FindObjectType("block")->size_m / 2.0;
+  const double last = (block[0].position_m - from).dot(dir) -
+                      (robot_.length_m / 2.0 + r + robot_.intake.reach_m);
+  for (double along = 0.0; along <= last; along += 0.01) {
+    const Eigen::Vector2d p = from + along * dir;
+    EXPECT_TRUE(platform::FootprintIsFree(season_, platform::Pose2D{p.x(), p.y(), a.target.z()},
+                                          robot_.length_m, robot_.width_m, robot_.height_m))
+        << a.why << ": heading " << a.target.z() * 180.0 / M_PI << " deg, blocked " << along
+        << " m along the approach from (" << from.transpose() << ")";
+  }
+}
+
 // A release estimated to end just after the deadline: with certain durations it is not
 // started; valued by its chance of ending in time (durations stray 0.2 of the estimate) it is,
 // at less expected points. Half the time it needs is not worth trying either way.
