@@ -158,6 +158,9 @@ field::SeasonConfig PlaceObjects(const field::SeasonConfig& season, double jitte
     if (preload) continue;
     const field::ObjectType* type = season.FindObjectType(p.type);
     const double r = type ? type->size_m / 2.0 : 0.1;
+    // Held in a structure (a Push Back loader's column): it stays where the structure holds it,
+    // whatever the layout.
+    if (platform::PointBlocksObject(season, nominal, r, type ? type->height_m : 0.0)) continue;
     for (int attempt = 0; attempt < 30; ++attempt) {
       const Eigen::Vector2d c = move(nominal);
       const double limit = season.HalfSize() - r;
