@@ -702,12 +702,11 @@ class Base : public Strategy {
     };
     const double corridor =
         options_.approach_margin_m + c.robot->intake.reach_m / 2.0 + kCorridorSlack_m;
-    std::optional<Eigen::Vector3d> stage =
-        PickStage(c, o.position_m, r, from.head<2>(), options_.approach_margin_m,
-                  [&](const Eigen::Vector3d& s) {
-                    return ApproachIsFree(c, s) &&
-                           CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
-                  });
+    std::optional<Eigen::Vector3d> stage = PickStage(
+        c, o.position_m, r, from.head<2>(), options_.approach_margin_m,
+        [&](const Eigen::Vector3d& s) {
+          return ApproachIsFree(c, s) && CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
+        });
     if (!stage) return out;
     const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
     const ObjectBelief* target = &o;

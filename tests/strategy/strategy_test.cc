@@ -830,8 +830,8 @@ TEST_F(StrategyTest, APickIsNotApproachedThroughAStructure) {
   const Eigen::Vector2d dir(std::cos(a.target.z()), std::sin(a.target.z()));
   // Where the bumper is the intake's reach short of the block's near edge.
   const double r = season_.FindObjectType("block")->size_m / 2.0;
-  const double last = (block[0].position_m - from).dot(dir) -
-                      (robot_.length_m / 2.0 + r + robot_.intake.reach_m);
+  const double last =
+      (block[0].position_m - from).dot(dir) - (robot_.length_m / 2.0 + r + robot_.intake.reach_m);
   for (double along = 0.0; along <= last; along += 0.01) {
     const Eigen::Vector2d p = from + along * dir;
     EXPECT_TRUE(platform::FootprintIsFree(season_, platform::Pose2D{p.x(), p.y(), a.target.z()},
