@@ -14,4 +14,10 @@ namespace slamo::vision {
 // any other image type) is handed to cv::resize itself.
 void ResizeAreaLike(const cv::Mat& src, double scale, cv::Mat* dst);
 
+// ResizeAreaLike, then cv::threshold(*dst, *dst, 127, 255, cv::THRESH_BINARY): the same
+// bytes. Only the target pixels whose source cell holds both 255 and something else are
+// summed (as ResizeAreaLike sums them); the rest are read off an integral image: a cell of
+// zeros gives 0, a cell of 255s gives 255.
+void ShrinkMaskLike(const cv::Mat& src, double scale, cv::Mat* dst);
+
 }  // namespace slamo::vision

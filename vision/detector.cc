@@ -41,16 +41,7 @@ void CheckInput(const cv::Mat& bgr, const cv::Mat& depth_mm) {
 // Median of the valid depth readings under a mask, raw millimetres; 0 when none.
 double MedianDepthMm(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box) {
   thread_local std::vector<uint16_t> readings;  // reused: no allocation per blob
-  if (readings.size() < static_cast<size_t>(box.area())) readings.resize(box.area());
-  size_t count = 0;
-  for (int v = box.y; v < box.y + box.height; ++v) {
-    const uint8_t* m = mask.ptr<uint8_t>(v);
-    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
-    for (int u = box.x; u < box.x + box.width; ++u) {
-      readings[count] = d[u];
-      count += (m[u] != 0) & (d[u] != 0);
-    }
-  }
+  const size_t count = MaskedReadings(depth_mm, mask, box, &readings);
   if (count == 0) return 0.0;
   return MedianReading(readings.data(), count);
 }
@@ -177,6 +168,17 @@ void MeasureArc(const std::vector<cv::Point>& points, ArcFit* fit) {
   fit->coverage_deg = 360.0 - gap * 180.0 / M_PI;
 }
 
+// |hypot(d) - radius| < tolerance, as std::hypot decides it, without calling it for the
+// points far from the band's edges: sqrt of the sum of squares is within a few units in the
+// last place of hypot (both within one of the exact distance), so where the two sides differ
+// by more than a relative 1e-12 the answer is the same; at the edge, hypot decides.
+bool NearCircle(const cv::Point2d& d, double radius, double tolerance) {
+  const double distance = std::sqrt(d.x * d.x + d.y * d.y);
+  const double margin = std::abs(distance - radius) - tolerance;
+  if (std::abs(margin) > 1e-12 * (distance + radius + tolerance)) return margin < 0.0;
+  return std::abs(std::hypot(d.x, d.y) - radius) < tolerance;
+}
+
 // A circle through an outline whose points may include straight stretches where something
 // else hides the object (a barrier's edge): fit, keep the points near the circle, refit.
 // `inlier_fraction` reports how much of the outline the final circle explains.
@@ -188,8 +190,7 @@ std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlie
     const double tolerance = std::max(1.5, 0.08 * fit->radius);
     kept.clear();
     for (const cv::Point& p : points) {
-      const cv::Point2d d = cv::Point2d(p) - fit->centre;
-      if (std::abs(std::hypot(d.x, d.y) - fit->radius) < tolerance) kept.push_back(p);
+      if (NearCircle(cv::Point2d(p) - fit->centre, fit->radius, tolerance)) kept.push_back(p);
     }
     if (kept.size() == inliers.size() || kept.size() < 8) break;
     std::swap(inliers, kept);
@@ -728,8 +729,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         const double scale =
             std::sqrt(static_cast<double>(options.separation_max_pixels) / blob_mask.total());
         cv::Mat small;
-        ResizeAreaLike(blob_mask, scale, &small);  // cv::resize(INTER_AREA), byte for byte
-        cv::threshold(small, small, 127, 255, cv::THRESH_BINARY);
+        // cv::resize(INTER_AREA) and a threshold at 127, byte for byte
+        ShrinkMaskLike(blob_mask, scale, &small);
         separated = SeparateTouching(small, options.separation, options.separation_options);
         for (std::vector<cv::Point>& piece : separated.pieces) {
           for (cv::Point& p : piece) {

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
@@ -124,6 +128,51 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
   return LeastCurvature{eigen.eigenvalues()(least), std::sqrt(std::max(0.0, variance))};
 }
 
+size_t MaskedReadings(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box,
+                      std::vector<uint16_t>* readings) {
+  // Room for a whole row's 16-reading stores past the last kept one.
+  const size_t room = static_cast<size_t>(box.area()) + 16;
+  if (readings->size() < room) readings->resize(room);
+  uint16_t* out = readings->data();
+  size_t count = 0;
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    const uint8_t* m = mask.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    int u = box.x;
+    const int end = box.x + box.width;
+#if defined(__SSE2__)
+    const __m128i zero = _mm_setzero_si128();
+    for (; u + 16 <= end; u += 16) {
+      const __m128i set = _mm_cmpeq_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(m + u)),
+                                         zero);  // 0xff where the mask is 0
+      const int background = _mm_movemask_epi8(set);
+      if (background == 0xffff) continue;
+      if (background == 0) {
+        const __m128i d0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + u));
+        const __m128i d1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + u + 8));
+        const __m128i no_reading =
+            _mm_or_si128(_mm_cmpeq_epi16(d0, zero), _mm_cmpeq_epi16(d1, zero));
+        if (_mm_movemask_epi8(no_reading) == 0) {
+          _mm_storeu_si128(reinterpret_cast<__m128i*>(out + count), d0);
+          _mm_storeu_si128(reinterpret_cast<__m128i*>(out + count + 8), d1);
+          count += 16;
+          continue;
+        }
+      }
+      for (int k = u; k < u + 16; ++k) {
+        out[count] = d[k];
+        count += (m[k] != 0) & (d[k] != 0);
+      }
+    }
+#endif
+    for (; u < end; ++u) {
+      out[count] = d[u];
+      count += (m[u] != 0) & (d[u] != 0);
+    }
+  }
+  return count;
+}
+
 uint16_t MedianReading(const std::vector<uint16_t>& readings) {
   return MedianReading(readings.data(), readings.size());
 }
@@ -147,16 +196,17 @@ uint16_t MedianReading(const uint16_t* r, size_t n) {
     if (rank < count) break;
     rank -= count;
   }
-  // Readings of another high byte go to a 257th bin, never read: no branch.
-  uint32_t low[4][257] = {};
-  const auto bin = [h](uint16_t reading) { return (reading >> 8) == h ? reading & 0xff : 256; };
+  // Every reading adds to the bin of its low byte: one if its high byte is h, else zero (no
+  // branch, and no single bin that every other reading would wait on).
+  uint32_t low[4][256] = {};
+  const auto in_h = [h](uint16_t reading) { return static_cast<uint32_t>((reading >> 8) == h); };
   for (i = 0; i + 4 <= n; i += 4) {
-    ++low[0][bin(r[i])];
-    ++low[1][bin(r[i + 1])];
-    ++low[2][bin(r[i + 2])];
-    ++low[3][bin(r[i + 3])];
+    low[0][r[i] & 0xff] += in_h(r[i]);
+    low[1][r[i + 1] & 0xff] += in_h(r[i + 1]);
+    low[2][r[i + 2] & 0xff] += in_h(r[i + 2]);
+    low[3][r[i + 3] & 0xff] += in_h(r[i + 3]);
   }
-  for (; i < n; ++i) ++low[0][bin(r[i])];
+  for (; i < n; ++i) low[0][r[i] & 0xff] += in_h(r[i]);
   unsigned l = 0;
   for (;; ++l) {
     const size_t count = size_t{low[0][l]} + low[1][l] + low[2][l] + low[3][l];
@@ -185,16 +235,7 @@ std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv:
   }
   const cv::Rect box = cv::boundingRect(inner);
   thread_local std::vector<uint16_t> readings;  // reused: no allocation per blob
-  if (readings.size() < static_cast<size_t>(box.area())) readings.resize(box.area());
-  size_t count = 0;
-  for (int v = box.y; v < box.y + box.height; ++v) {
-    const uint8_t* m = inner.ptr<uint8_t>(v);
-    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
-    for (int u = box.x; u < box.x + box.width; ++u) {
-      readings[count] = d[u];
-      count += (m[u] != 0) & (d[u] != 0);
-    }
-  }
+  const size_t count = MaskedReadings(depth_mm, inner, box, &readings);
   if (static_cast<int>(count) < options.min_depth_pixels) return std::nullopt;
   const double surface_m = camera.CorrectDepthM(MedianReading(readings.data(), count));
   if (!(surface_m > 0.0)) return std::nullopt;

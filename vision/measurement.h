@@ -101,6 +101,12 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
 uint16_t MedianReading(const std::vector<uint16_t>& readings);
 uint16_t MedianReading(const uint16_t* readings, size_t count);  // count > 0
 
+// The non-zero readings of `depth_mm` (CV_16UC1) under the non-zero pixels of `mask` (CV_8UC1,
+// the same size) inside `box`, row by row, into `readings` (grown as needed, never shrunk);
+// returns how many. Sixteen pixels at a time where the mask is all background or all set.
+size_t MaskedReadings(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box,
+                      std::vector<uint16_t>* readings);
+
 // Range and bearing in the robot frame of a pixel with its (centre) depth.
 Eigen::Vector2d RangeBearing(const CameraModel& camera, double u, double v, double z_m);
 

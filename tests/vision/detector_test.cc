@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+
+#include <opencv2/core.hpp>
 
 #include "field_configs/loader.h"
 #include "platform/sim/sim_renderer.h"
@@ -363,6 +366,56 @@ TEST(LandmarkDetectionTest, FindsTheMarkersOnTheFarWall) {
   }
   EXPECT_GE(matched, 2);
   EXPECT_LE(found.size(), truth.landmarks.size());  // nothing else taken for a marker
+}
+
+// The readings under a mask, sixteen pixels at a time where it can: the same readings, in the
+// same order, as one pixel at a time. Masks of runs (whole chunks set, whole chunks clear, and
+// chunks of both), depth with holes, boxes of any size and views into larger images.
+TEST(MaskedReadingsTest, SameAsPixelByPixel) {
+  std::mt19937 rng(41);
+  int whole_chunks = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    const int w = 1 + static_cast<int>(rng() % 120), h = 1 + static_cast<int>(rng() % 40);
+    cv::Mat mask(h + 2, w + 3, CV_8UC1, cv::Scalar(0)), depth(h + 2, w + 3, CV_16UC1);
+    cv::randu(depth, 0, 4000);
+    for (int v = 0; v < mask.rows; ++v) {
+      for (int u = 0; u < mask.cols;) {
+        const int run = 1 + static_cast<int>(rng() % 40);
+        const uint8_t value = rng() % 2 == 0 ? 0 : static_cast<uint8_t>(1 + rng() % 255);
+        for (int k = u; k < std::min(mask.cols, u + run); ++k) mask.at<uint8_t>(v, k) = value;
+        u += run;
+      }
+      for (int u = 0; u < depth.cols; ++u) {  // no reading: 1 in 500, or 1 in 20
+        if (rng() % (trial % 2 == 0 ? 500 : 20) == 0) {
+          depth.at<uint16_t>(v, u) = 0;
+        } else {
+          depth.at<uint16_t>(v, u) |= 1;
+        }
+      }
+    }
+    const cv::Rect box(static_cast<int>(rng() % 3), static_cast<int>(rng() % 2), w, h);
+    std::vector<uint16_t> expected;
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        if (mask.at<uint8_t>(v, u) != 0 && depth.at<uint16_t>(v, u) != 0) {
+          expected.push_back(depth.at<uint16_t>(v, u));
+        }
+      }
+      for (int u = box.x; u + 16 <= box.x + box.width; u += 16) {
+        bool all_valid = true;
+        for (int k = u; k < u + 16; ++k) {
+          all_valid &= mask.at<uint8_t>(v, k) != 0 && depth.at<uint16_t>(v, k) != 0;
+        }
+        whole_chunks += all_valid ? 1 : 0;
+      }
+    }
+    std::vector<uint16_t> readings(trial % 3 == 0 ? 0 : 5);
+    const size_t count = MaskedReadings(depth, mask, box, &readings);
+    ASSERT_EQ(count, expected.size()) << "trial " << trial;
+    ASSERT_TRUE(std::equal(expected.begin(), expected.end(), readings.begin()))
+        << "trial " << trial;
+  }
+  EXPECT_GT(whole_chunks, 100);  // the sixteen-at-a-time path was taken
 }
 
 }  // namespace
