@@ -72,6 +72,7 @@ const std::map<std::string, std::string>& TunableParams() {
       {"check_spacing", "m of path between quick looks while driving (0: none)"},
       {"correction_frames", "frames of a quick look"},
       {"arrival_fixes", "look-and-correct rounds on arrival"},
+      {"arrival_slack", "error after an arrival's look left to the next action's own aim, m"},
       {"floor_push", "1: objects on the floor may be pushed into a zone that pays more; 0: never"},
       {"push_loss",
        "planner: 1 counts against a sequence what its first drive pushes out of our zones, and "
@@ -122,6 +123,8 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->correction_frames = ToInt(name, value);
   } else if (name == "arrival_fixes") {
     setup->arrival_fixes = ToInt(name, value);
+  } else if (name == "arrival_slack") {
+    setup->arrival_slack_m = ToDouble(name, value);
   } else if (name == "floor_push") {
     if (value != "0" && value != "1")
       throw std::invalid_argument("--param floor_push: expected 0 or 1, got \"" + value + "\"");

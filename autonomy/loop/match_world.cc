@@ -420,6 +420,11 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
                           double budget_s) {
   const double give_up_s = budget_s > 0.0 ? now_s() + budget_s : deadline_s_;
   const auto out_of_time = [&]() { return now_s() >= std::min(give_up_s, deadline_s_); };
+  // The error an arrival leaves: its tolerance, or what the next action's aim absorbs.
+  const double arrival_accepts =
+      std::max(setup_.arrival_tolerance_m, setup_.arrival_slack_m >= 0.0
+                                               ? setup_.arrival_slack_m
+                                               : 0.5 * setup_.strategy_options.approach_margin_m);
   for (int attempt = 0; attempt < 3 && !out_of_time(); ++attempt) {
     Eigen::Vector3d pose = slam_.pose();
     if (!planner_->IsClear(pose.head<2>())) {
@@ -549,7 +554,7 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
     for (int fix = 0; perceive_ && fix < setup_.arrival_fixes && !out_of_time(); ++fix) {
       Observe(std::max(frames_per_stop, setup_.correction_frames));
       const Eigen::Vector2d d = target.head<2>() - slam_.pose().head<2>();
-      if (d.norm() < setup_.arrival_tolerance_m) break;
+      if (d.norm() < arrival_accepts) break;
       const double turn = platform::WrapAngleRad(std::atan2(d.y(), d.x()) - slam_.pose().z());
       if (std::abs(turn) > kPi / 2) {  // overshot: back up rather than turn round
         Drive({Turn(platform::WrapAngleRad(turn + kPi) * 180.0 / kPi),
