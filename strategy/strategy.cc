@@ -1022,8 +1022,15 @@ class PlannerStrategy : public Base {
       return 0.5 *
              std::erfc((seconds - left) / (options_.duration_spread * seconds * std::sqrt(2.0)));
     };
+    double unlooked_rate = 0.0;  // the best points per second of a sequence without a look
+    double look_cost = 0.0;      // what the look of the frames being searched is charged
     const auto consider = [&](const Cycle& first, double j, double seconds) {
       if (in_time(seconds) < kMinInTime) return;
+      if (first.frames == 0) {
+        unlooked_rate = std::max(unlooked_rate, j / std::max(seconds, 1e-3));
+      } else {
+        j -= look_cost;
+      }
       // The executive refuses an action whose own estimate exceeds the time left: a sequence
       // that may still end in time must at least start in time.
       if (seconds > left && FirstAction(b, c, first, j).expected_s > left) return;
@@ -1032,8 +1039,12 @@ class PlannerStrategy : public Base {
         best = first, best_j = j, best_rate = rate;
       }
     };
-    for (int frames : options_.frame_choices) {
+    // Without a look first, so that the looks are charged at the best rate without one.
+    std::vector<int> frame_choices = options_.frame_choices;
+    std::stable_sort(frame_choices.begin(), frame_choices.end());
+    for (int frames : frame_choices) {
       if (frames > 0 && just_observed_) continue;  // observing twice in a row gains little
+      look_cost = options_.look_charge * unlooked_rate * frames / c.frame_rate_hz;
       std::vector<Cycle> firsts = b.held ? HeldCycles(b, c, frames) : std::vector<Cycle>{};
       // Held: its goals, floor zones included (releasing it on the floor frees the intake).
       if (!b.held) {

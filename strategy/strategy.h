@@ -108,6 +108,10 @@ struct StrategyOptions {
   double push_run_in_m = 0.35;      // knock: straight run-in to the object on a raised structure
   double pick_tolerance_m = 0.12;   // lateral error the intake forgives
   std::vector<int> frame_choices = {0, 5, 10, 20};
+  // Planner: a look before a cycle is charged its seconds at the best rate (points per
+  // second) of the sequences that start without one, times this: the time it takes is lost
+  // to what comes after the search's horizon (0: a look costs only what it pushes out of time).
+  double look_charge = 1.0;
   // Pose information one frame of landmarks adds, as position sigmas (m): white per frame,
   // bias per stop (the iterated-frame model: sigma^2 = white^2 / n + bias^2).
   double frame_white_sigma_m = 0.03;

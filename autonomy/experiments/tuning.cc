@@ -82,6 +82,9 @@ const std::map<std::string, std::string>& TunableParams() {
       {"pushable", "objects narrower than this fraction of the robot are pushed, not avoided"},
       {"arrival_frames", "planner: frames to check an arrival"},
       {"observe_first", "planner: 1 weighs observing before a cycle (frames 5, 10, 20); 0 never"},
+      {"look_charge",
+       "planner: a look before a cycle is charged its seconds at this times the best rate "
+       "without one (0: only what it pushes out of time)"},
       {"gyro", "1: a yaw gyro's heading into SLAM-O; 0: encoders and camera only"},
       {"adaptive", "1: the EKF's adaptive noise (NIS, sensor/motion checks, re-acquire); 0: off"},
       {"planner", "OMPL planner: rrtconnect | rrtstar | informedrrtstar | prmstar | bitstar"},
@@ -144,6 +147,8 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
       throw std::invalid_argument("--param observe_first: expected 0 or 1");
     setup->strategy_options.frame_choices =
         value == "1" ? std::vector<int>{0, 5, 10, 20} : std::vector<int>{0};
+  } else if (name == "look_charge") {
+    setup->strategy_options.look_charge = ToDouble(name, value);
   } else if (name == "gyro") {
     if (value != "0" && value != "1")
       throw std::invalid_argument("--param gyro: expected 0 or 1, got \"" + value + "\"");
