@@ -130,8 +130,8 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
 
 size_t MaskedReadings(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box,
                       std::vector<uint16_t>* readings) {
-  // Room for a whole row's 16-reading stores past the last kept one.
-  const size_t room = static_cast<size_t>(box.area()) + 16;
+  // Every pixel's reading is written at `count` (kept or overwritten), at most one per pixel.
+  const size_t room = static_cast<size_t>(box.area());
   if (readings->size() < room) readings->resize(room);
   uint16_t* out = readings->data();
   size_t count = 0;

@@ -66,8 +66,8 @@ struct MatchSetup {
   double arrival_tolerance_m = 0.04;
   // After an arrival's look, an error up to this is left to the next action, which aims from
   // the estimate itself (a pick, a release, a push, each driving its own straight approach
-  // from the stage): no correcting drive for it. Negative: half the
-  // strategy's approach_margin_m, the straight run the next action has to absorb it in.
+  // from the stage): no correcting drive for it. Negative: half the strategy's
+  // approach_margin_m, the straight run the next action has to absorb it in.
   double arrival_slack_m = -1.0;
   double pushable_fraction = 1.0;
   // Path legs behind the robot up to this long are driven backwards instead of turning round
