@@ -248,6 +248,114 @@ std::vector<uint8_t> FloatingColumns(const cv::Mat& blob_mask, cv::Point offset,
   return floating;
 }
 
+// How many times smaller the image K-Means clusters is (DetectOptions::kmeans_downsample).
+int KMeansFactor(const cv::Mat& bgr, const DetectOptions& options) {
+  return options.kmeans_downsample > 0
+             ? options.kmeans_downsample
+             : std::max(1, static_cast<int>(std::lround(bgr.cols / 256.0)));
+}
+
+// Whether a pixel could be of `colour` in shade or half in a highlight: its hue within the
+// class's window, its saturation and value at least half the class's gates.
+bool ShadeOf(const cv::Vec3b& bgr, const ColourClass& colour) {
+  const int b = bgr[0], g = bgr[1], r = bgr[2];
+  const int hi = std::max({r, g, b}), lo = std::min({r, g, b});
+  if (hi == 0 || hi < colour.min_value / 2) return false;
+  if (255 * (hi - lo) < hi * (colour.min_saturation / 2)) return false;  // also grey: hi == lo
+  const double c = hi - lo;
+  double hue = 0.0;
+  if (hi == r) {
+    hue = 60.0 * (g - b) / c;
+  } else if (hi == g) {
+    hue = 120.0 + 60.0 * (b - r) / c;
+  } else {
+    hue = 240.0 + 60.0 * (r - g) / c;
+  }
+  return std::abs(std::remainder(hue - colour.hue_deg, 360.0)) <= colour.hue_tolerance_deg;
+}
+
+// Whether the top of `piece_mask` (at `offset` in the image) runs on into what lies over it
+// (DetectOptions::attach_margin_ratio). Per column, the top of the piece's colour there
+// (`own_colour`, the mask the piece came from, whose outline may lie a pixel or two outside
+// the piece's): the mean reading of two of its rows against the farthest of the
+// `above_rows` rows over it, one row up (the edge row may read between the two surfaces); the
+// two rows are its top two, or for a mask drawn `mask_scale` times coarser than the image
+// (K-Means) the two at that depth into it, since its outline may run that far past the
+// object's. Not judged: a column whose colour runs on over the piece (an object of its colour
+// stacked on it, split off), whose rows over the top carry a target colour (`targets`, every
+// target colour's mask: an object of another colour on it) or a shade of the piece's own
+// (`bgr`: the dark or highlit part of one of its colour that the mask missed), whose rows over
+// it read nothing, or read the floor (under attach_floor_m: it runs on past everything that
+// stands on it). True when the median step (over the top minus its own) of the judged
+// columns, plus 2 sigma of the median from the depth noise, stays under `margin_m`, with at
+// least attach_min_columns, and attach_min_judged of the piece's columns, judged.
+bool RunsOnAbove(const cv::Mat& piece_mask, cv::Point offset, const cv::Mat& depth_mm,
+                 const cv::Mat& bgr, const ColourClass& colour, const cv::Mat& own_colour,
+                 const std::vector<cv::Mat>& targets, const CameraModel& camera,
+                 const DetectOptions& options, int mask_scale, double margin_m) {
+  // How far the colour's outline may lie outside the piece's; and a target colour this many
+  // rows beyond those read still counts as stacked (K-Means masks, drawn at half resolution
+  // and opened, leave a gap of a few rows between colours).
+  constexpr int kOutlineRows = 2;
+  constexpr int kStackGapRows = 3;
+  const int above_rows = options.attach_above_rows;
+  std::vector<double> steps;
+  double sigma_sum = 0.0;
+  int columns = 0;
+  for (int u = 0; u < piece_mask.cols; ++u) {
+    int top = -1;
+    for (int v = 0; v < piece_mask.rows; ++v) {
+      if (piece_mask.at<uint8_t>(v, u)) {
+        top = v;
+        break;
+      }
+    }
+    if (top < 0) continue;
+    ++columns;
+    const int x = u + offset.x;
+    int y = top + offset.y;
+    int climbed = 0;
+    while (y > 0 && own_colour.at<uint8_t>(y - 1, x) && climbed <= kOutlineRows) --y, ++climbed;
+    if (climbed > kOutlineRows) continue;                  // its colour runs on: stacked
+    if (y - 1 - above_rows - kStackGapRows < 0) continue;  // the image ends over it
+    bool stacked = false;
+    for (int k = 1; k <= 1 + above_rows + kStackGapRows && !stacked; ++k)
+      stacked = ShadeOf(bgr.at<cv::Vec3b>(y - k, x), colour) ||
+                std::any_of(targets.begin(), targets.end(),
+                            [&](const cv::Mat& m) { return m.at<uint8_t>(y - k, x) != 0; });
+    if (stacked) continue;
+    double own_sum = 0.0;
+    int n_own = 0;
+    for (int v = y + mask_scale - 1; v < std::min(depth_mm.rows, y + mask_scale + 1); ++v) {
+      const uint16_t raw = depth_mm.at<uint16_t>(v, x);
+      if (raw) own_sum += camera.CorrectDepthM(raw), ++n_own;
+    }
+    if (n_own == 0) continue;
+    const double own_m = own_sum / n_own;
+    double above = -1.0;
+    int above_row = 0;
+    for (int k = 2; k <= 1 + above_rows; ++k) {
+      const uint16_t raw = depth_mm.at<uint16_t>(y - k, x);
+      if (raw && camera.CorrectDepthM(raw) > above)
+        above = camera.CorrectDepthM(raw), above_row = y - k;
+    }
+    if (above < 0.0) continue;
+    if (camera.CameraToRobot(camera.BackProject(x, above_row, above)).z() < options.attach_floor_m)
+      continue;
+    steps.push_back(above - own_m);
+    sigma_sum += camera.DepthSigmaM(own_m);
+  }
+  const int judged = static_cast<int>(steps.size());
+  if (judged < options.attach_min_columns || judged < options.attach_min_judged * columns)
+    return false;
+  std::nth_element(steps.begin(), steps.begin() + judged / 2, steps.end());
+  const double median = steps[judged / 2];
+  // A step is the difference of two readings (own: the mean of two), sigma x sqrt(1.5); the
+  // median of n of them has about 1.25 / sqrt(n) of that.
+  const double sigma = 1.25 * std::sqrt(1.5) * (sigma_sum / judged) / std::sqrt(judged);
+  return std::abs(median) + 2.0 * sigma <= margin_m;
+}
+
 // Clears from `blob_mask` every run of at least `min_run` floating columns (FloatingColumns);
 // true when any was cleared. Unknown columns next to floating ones float with them (they show
 // nothing standing), and gaps of at most `max_gap` standing columns between floating ones are
@@ -355,9 +463,7 @@ std::vector<TargetKind> KindsOf(const DetectorSetup& setup, const std::string& c
 
 cv::Mat KMeansLabels(const cv::Mat& bgr, const DetectorSetup& setup, const DetectOptions& options,
                      std::vector<int>* cluster_class, cv::Size* small_size) {
-  const int ds = options.kmeans_downsample > 0
-                     ? options.kmeans_downsample
-                     : std::max(1, static_cast<int>(std::lround(bgr.cols / 256.0)));
+  const int ds = KMeansFactor(bgr, options);
   cv::Mat small;
   cv::resize(bgr, small, cv::Size(bgr.cols / ds, bgr.rows / ds), 0, 0, cv::INTER_AREA);
   *small_size = small.size();
@@ -888,6 +994,26 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                   ++st.rejected_flat;
                   continue;
                 }
+              }
+            }
+            if (best->round && best->solid && options.attach_margin_ratio > 0.0) {
+              // The least step anything touching the object from behind can show over its
+              // top, seen down at alpha (the ray through the piece's top): r (1 - sin alpha)
+              // / cos alpha; r when seen level or from below.
+              const CameraModel& camera = *setup.camera;
+              const Eigen::Vector3d ray =
+                  camera.CameraToRobot(camera.BackProject(d.centre_px.x, d.box.y, 1.0)) -
+                  camera.CameraToRobot(Eigen::Vector3d::Zero());
+              const double alpha =
+                  std::max(0.0, std::atan2(-ray.z(), std::hypot(ray.x(), ray.y())));
+              const double least_step = best->radius_m * (1.0 - std::sin(alpha)) / std::cos(alpha);
+              const bool drop = RunsOnAbove(
+                  piece_mask, roi.tl(), depth_mm, bgr, colour, masks[j], masks, camera, options,
+                  options.method == DetectMethod::kKMeans ? KMeansFactor(bgr, options) : 1,
+                  options.attach_margin_ratio * least_step);
+              if (drop) {
+                ++st.rejected_attached;
+                continue;
               }
             }
             d.kind = best->name;

@@ -77,6 +77,24 @@ struct DetectOptions {
   // float_min_columns floating columns, and at least float_min_run_widths of the largest
   // kind's apparent width at the blob's depth, are cleared (a narrower run may be the
   // overhang of an object on a thin support: a cube on a post).
+  // With depth, for round solid kinds: the top of a ball's or triball's outline is an
+  // occluding edge (over it the camera sees past the object, or something in front of it;
+  // anything touching it from behind lies deeper, by its radius seen level and by r (1 - sin
+  // a) / cos a seen down at a), while the top of a piece that is the lower part of a taller
+  // body runs on into that body at its own depth (a robot's bumper under its chassis). Per
+  // column of a piece, the depth of its top rows against the rows over them (RunsOnAbove in
+  // detector.cc); a column is judged unless what lies over it is of a target colour or a
+  // shade of the piece's own (a stack), reads nothing, or is the floor (under
+  // attach_floor_m). The piece is dropped when at least attach_min_columns, and
+  // attach_min_judged of its columns, are judged and their median step plus 2 sigma of it
+  // stays under attach_margin_ratio x that least step. Rings, cubes and blocks are not
+  // tested: their outline's top is their far edge, which whatever they touch meets at the same
+  // depth (the float test judges bumpers there). 0: off.
+  double attach_margin_ratio = 0.75;
+  double attach_min_judged = 0.25;
+  int attach_min_columns = 3;
+  int attach_above_rows = 2;     // rows over the top (after one skipped: mixed edge readings)
+  double attach_floor_m = 0.03;  // over the top, a point this low is the floor
   bool drop_floating = true;
   double float_margin_m = 0.02;
   int float_below_rows = 2;
@@ -149,6 +167,7 @@ struct DetectStats {
   int rejected_flat = 0;      // round solid kinds whose surface does not curve (a bumper's face)
   int split_by_size = 0;      // blobs separated by the objects' known size
   int rejected_floating = 0;  // blobs with a part held off the floor over nothing (cleared)
+  int rejected_attached = 0;  // pieces whose top runs on into a taller body (a bumper's chassis)
   int without_depth = 0;      // kept, but no range: no valid depth on them (or, without a depth
                               // image, no kind resting on the floor fits their size)
 };

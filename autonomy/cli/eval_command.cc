@@ -29,6 +29,7 @@ struct EvalArgs {
   bool no_size_split = false;
   bool no_bulge_test = false;
   bool no_curvature_test = false;
+  bool no_attach_test = false;
   bool no_float_test = false;
 };
 
@@ -47,6 +48,7 @@ int RunVision(const EvalArgs& args) {
   options.detect.split_by_size = !args.no_size_split;
   if (args.no_bulge_test) options.detect.min_bulge_ratio = 0.0;
   if (args.no_curvature_test) options.detect.flat_curvature_ratio = 0.0;
+  if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
   options.detect.drop_floating = !args.no_float_test;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
@@ -118,6 +120,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   vision->add_flag("--no-curvature-test", args->no_curvature_test,
                    "keep round detections flat along some direction (the detector before the "
                    "test, for comparison)");
+  vision->add_flag("--no-attach-test", args->no_attach_test,
+                   "keep pieces whose top runs on into a taller body at their depth (a "
+                   "bumper under its chassis; the detector before the test, for comparison)");
   vision->add_flag("--no-float-test", args->no_float_test,
                    "keep blobs held off the floor over nothing (the detector before the test, "
                    "for comparison)");

@@ -123,11 +123,14 @@ TEST(VisionEvalTest, BumpersOffTheFloorAreNotTakenForRings) {
 // an opponent's bumper running diagonally in the image, which the bulge test's row and column
 // bands take for triballs, are dropped. Measured with `slamo eval vision --season over_under
 // --arena --frames 50 --seed 1 [--no-curvature-test]`: false detections on robots 159 -> 103
-// over the six methods.
+// over the six methods. Both without the attach test that came after it (below), which drops
+// many of the same pieces.
 TEST(VisionEvalTest, BumperPiecesFlatAlongTheirLengthAreNotTakenForTriballs) {
-  VisionEvalOptions without;
+  VisionEvalOptions with;
+  with.detect.attach_margin_ratio = 0.0;
+  VisionEvalOptions without = with;
   without.detect.flat_curvature_ratio = 0.0;
-  const std::vector<VisionMethodScore> with_test = Scores("over_under", 50, 1, true);
+  const std::vector<VisionMethodScore> with_test = Scores("over_under", 50, 1, true, with);
   const std::vector<VisionMethodScore> without_test = Scores("over_under", 50, 1, true, without);
   ASSERT_EQ(with_test.size(), without_test.size());
   int on_robots = 0, on_robots_before = 0, found = 0, found_before = 0;
@@ -142,6 +145,29 @@ TEST(VisionEvalTest, BumperPiecesFlatAlongTheirLengthAreNotTakenForTriballs) {
   EXPECT_GT(on_robots_before, 100);
   EXPECT_LT(on_robots, 0.75 * on_robots_before);
   EXPECT_GE(found, found_before - 2);
+}
+
+// The top of a round piece must not run on into a taller body (DetectOptions::
+// attach_margin_ratio): pieces of the opponents' bumpers, under their chassis, are dropped and
+// no triball is lost. Measured with `slamo eval vision --season over_under --arena --frames 30
+// --seed 1 [--no-attach-test]`: false detections on robots 58 -> 23 over the six methods,
+// precision up for each (kmeans+defects 0.824 -> 0.886), recall the same for each.
+TEST(VisionEvalTest, BumperPiecesUnderTheirChassisAreNotTakenForTriballs) {
+  VisionEvalOptions without;
+  without.detect.attach_margin_ratio = 0.0;
+  const std::vector<VisionMethodScore> with_test = Scores("over_under", 30, 1, true);
+  const std::vector<VisionMethodScore> without_test = Scores("over_under", 30, 1, true, without);
+  ASSERT_EQ(with_test.size(), without_test.size());
+  int on_robots = 0, on_robots_before = 0;
+  for (size_t k = 0; k < with_test.size(); ++k) {
+    SCOPED_TRACE(with_test[k].name);
+    EXPECT_GT(with_test[k].Precision(), without_test[k].Precision());
+    EXPECT_EQ(with_test[k].found, without_test[k].found);
+    on_robots += with_test[k].false_on_robots;
+    on_robots_before += without_test[k].false_on_robots;
+  }
+  EXPECT_GT(on_robots_before, 40);
+  EXPECT_LT(2 * on_robots, on_robots_before);
 }
 
 // Piles (#16 item 4): `--pile 10,30` puts a heap of touching blocks in every view; split by
