@@ -198,9 +198,6 @@ cv::v_uint8x16 In(const ByteWindow& w, const cv::v_uint8x16& x) {
 }
 #endif
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#define SLAMO_THRESHOLD_BGR_AVX2 1
-
 // cv::cvtColor's 8-bit BGR -> HSV (hue 0..180), integer for integer: with v the largest
 // channel and diff = v - smallest, s = (diff * round(255 * 2^12 / v) + 2^11) >> 12 and
 // h = (d * round(30 * 2^12 / diff) + 2^11) >> 12, plus 180 when negative, where d is g - b,
@@ -229,6 +226,9 @@ cv::Vec3b BgrToHsv(const HsvDivisors& div, int b, int g, int r) {
   if (h < 0) h += 180;
   return cv::Vec3b(static_cast<uint8_t>(h), static_cast<uint8_t>(s), static_cast<uint8_t>(v));
 }
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SLAMO_THRESHOLD_BGR_AVX2 1
 
 // Where each byte of 16 BGR pixels lies in their 48 bytes: index[c][k] gathers channel c's
 // bytes that are in the k-th 16 (-1 elsewhere, for _mm_shuffle_epi8).
@@ -417,6 +417,14 @@ std::vector<cv::Mat> ThresholdHsv(const cv::Mat& hsv, const std::vector<ColourCl
     }
   }
   return masks;
+}
+
+bool InColourClass(const cv::Vec3b& bgr, const ColourClass& colour) {
+  static const HsvDivisors divisors;
+  const cv::Vec3b hsv = BgrToHsv(divisors, bgr[0], bgr[1], bgr[2]);
+  const HsvWindows w = WindowsOf(colour);
+  return (In(w.hue[0], hsv[0]) || In(w.hue[1], hsv[0])) && In(w.saturation, hsv[1]) &&
+         In(w.value, hsv[2]);
 }
 
 cv::Mat ThresholdHsv(const cv::Mat& hsv, const ColourClass& colour) {

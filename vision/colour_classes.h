@@ -41,6 +41,9 @@ std::vector<ColourClass> LoadColourClasses(const std::string& path);
 // Binary mask (CV_8UC1, 255 = in class) of an HSV image (OpenCV 8-bit: hue 0..180).
 cv::Mat ThresholdHsv(const cv::Mat& hsv, const ColourClass& colour);
 
+// Whether one 8-bit BGR pixel is in `colour`: the test ThresholdBgr makes of each pixel.
+bool InColourClass(const cv::Vec3b& bgr, const ColourClass& colour);
+
 // ThresholdHsv of each class, the same masks, in one pass over the image.
 std::vector<cv::Mat> ThresholdHsv(const cv::Mat& hsv, const std::vector<ColourClass>& colours);
 

@@ -255,25 +255,6 @@ int KMeansFactor(const cv::Mat& bgr, const DetectOptions& options) {
              : std::max(1, static_cast<int>(std::lround(bgr.cols / 256.0)));
 }
 
-// Whether a pixel could be of `colour` in shade or half in a highlight: its hue within the
-// class's window, its saturation and value at least half the class's gates.
-bool ShadeOf(const cv::Vec3b& bgr, const ColourClass& colour) {
-  const int b = bgr[0], g = bgr[1], r = bgr[2];
-  const int hi = std::max({r, g, b}), lo = std::min({r, g, b});
-  if (hi == 0 || hi < colour.min_value / 2) return false;
-  if (255 * (hi - lo) < hi * (colour.min_saturation / 2)) return false;  // also grey: hi == lo
-  const double c = hi - lo;
-  double hue = 0.0;
-  if (hi == r) {
-    hue = 60.0 * (g - b) / c;
-  } else if (hi == g) {
-    hue = 120.0 + 60.0 * (b - r) / c;
-  } else {
-    hue = 240.0 + 60.0 * (r - g) / c;
-  }
-  return std::abs(std::remainder(hue - colour.hue_deg, 360.0)) <= colour.hue_tolerance_deg;
-}
-
 // Whether the top of `piece_mask` (at `offset` in the image) runs on into what lies over it
 // (DetectOptions::attach_margin_ratio). Per column, the top of the piece's colour there
 // (`own_colour`, the mask the piece came from, whose outline may lie a pixel or two outside
@@ -293,6 +274,10 @@ bool RunsOnAbove(const cv::Mat& piece_mask, cv::Point offset, const cv::Mat& dep
                  const cv::Mat& bgr, const ColourClass& colour, const cv::Mat& own_colour,
                  const std::vector<cv::Mat>& targets, const CameraModel& camera,
                  const DetectOptions& options, int mask_scale, double margin_m) {
+  // The piece's colour in shade or half in a highlight: its hue, half its saturation and value.
+  ColourClass shade = colour;
+  shade.min_saturation /= 2;
+  shade.min_value /= 2;
   // How far the colour's outline may lie outside the piece's; and a target colour this many
   // rows beyond those read still counts as stacked (K-Means masks, drawn at half resolution
   // and opened, leave a gap of a few rows between colours).
@@ -320,7 +305,7 @@ bool RunsOnAbove(const cv::Mat& piece_mask, cv::Point offset, const cv::Mat& dep
     if (y - 1 - above_rows - kStackGapRows < 0) continue;  // the image ends over it
     bool stacked = false;
     for (int k = 1; k <= 1 + above_rows + kStackGapRows && !stacked; ++k)
-      stacked = ShadeOf(bgr.at<cv::Vec3b>(y - k, x), colour) ||
+      stacked = InColourClass(bgr.at<cv::Vec3b>(y - k, x), shade) ||
                 std::any_of(targets.begin(), targets.end(),
                             [&](const cv::Mat& m) { return m.at<uint8_t>(y - k, x) != 0; });
     if (stacked) continue;

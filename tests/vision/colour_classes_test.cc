@@ -62,6 +62,41 @@ TEST(ColourClassesTest, ThresholdBgrMatchesHsvOnEveryColour) {
   }
 }
 
+// One pixel at a time (InColourClass, which the detector asks of the rows over a piece), the
+// same answers as the HSV path's masks: one season's object classes, with and without their
+// saturation and value gates halved (the detector's shades), on 2^20 colours spread over the
+// cube (every fourth value of each channel).
+TEST(ColourClassesTest, OnePixelMatchesTheMasks) {
+  cv::Mat bgr(1024, 1024, CV_8UC3);
+  for (int v = 0; v < bgr.rows; ++v) {
+    for (int u = 0; u < bgr.cols; ++u) {
+      const int colour = v * 1024 + u;
+      bgr.at<cv::Vec3b>(v, u) =
+          cv::Vec3b(4 * (colour & 63), 4 * (colour >> 6 & 63), 4 * (colour >> 12 & 63) + 3);
+    }
+  }
+  std::vector<ColourClass> colours = ObjectColourClasses(field::LoadSeasonConfig("toss_up"));
+  for (ColourClass c : std::vector<ColourClass>(colours)) {
+    c.min_saturation /= 2;
+    c.min_value /= 2;
+    colours.push_back(c);
+  }
+  const std::vector<cv::Mat> masks = HsvPath(bgr, colours);
+  for (size_t j = 0; j < colours.size(); ++j) {
+    SCOPED_TRACE(colours[j].name + (j >= colours.size() / 2 ? " (shade)" : ""));
+    int differ = 0, in = 0;
+    for (int v = 0; v < bgr.rows; ++v) {
+      for (int u = 0; u < bgr.cols; ++u) {
+        const bool one = InColourClass(bgr.at<cv::Vec3b>(v, u), colours[j]);
+        differ += one != (masks[j].at<uint8_t>(v, u) != 0);
+        in += one;
+      }
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(in, 1000);  // the classes are not empty on these colours
+  }
+}
+
 // Windows at the edges: wrapping at 0/360, one hue step wide, no saturation or value floor,
 // the full saturation and value only, the widest hue window; and a part of an image.
 TEST(ColourClassesTest, ThresholdBgrMatchesHsvAtWindowEdges) {
