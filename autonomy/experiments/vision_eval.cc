@@ -294,6 +294,7 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
       std::set<int> matched;
       std::map<int, int> detections_on;  // object id -> kept detections of its colour on it
       std::vector<const vision::Detection*> kept, rejected, false_kept;
+      std::vector<FalseOn> false_on;  // what each of false_kept lies on
       for (const vision::Detection& d : found) {
         const int id = TruthIdUnder(d, truth.ids);
         const SimObject* object = id ? object_of[id] : nullptr;
@@ -318,7 +319,8 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
         if (!hit) {
           ++s.false_positives;
           false_kept.push_back(&d);
-          switch (FalseDetectionOn(d, truth.ids, object_of)) {
+          false_on.push_back(FalseDetectionOn(d, truth.ids, object_of));
+          switch (false_on.back()) {
             case FalseOn::kPiece:
               ++s.false_pieces;
               break;
@@ -410,8 +412,8 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
         continue;
       }
       // The frame as the method saw it: detections kept (green; yellow when split), false
-      // ones among them (magenta box), those the field gate dropped (grey), and the
-      // expected objects missed (red boxes).
+      // ones among them (magenta box, labelled with what they lie on), those the field gate
+      // dropped (grey), and the expected objects missed (red boxes).
       std::vector<vision::Detection> shown;
       for (const vision::Detection* d : kept) shown.push_back(*d);
       cv::Mat out = vision::DrawDetections(frame.colour, shown);
@@ -420,8 +422,12 @@ std::vector<VisionMethodScore> EvaluateVision(const field::SeasonConfig& season,
                          cv::Scalar(150, 150, 150), 2, cv::LINE_AA);
         Label(&out, "off field", d->box.tl() + cv::Point(0, -3), cv::Scalar(190, 190, 190));
       }
-      for (const vision::Detection* d : false_kept) {
-        cv::rectangle(out, d->box, cv::Scalar(255, 0, 255), 1);
+      for (size_t k = 0; k < false_kept.size(); ++k) {
+        const cv::Rect& box = false_kept[k]->box;
+        cv::rectangle(out, box, cv::Scalar(255, 0, 255), 1);
+        static const char* const kOn[] = {"false: piece", "false: robot", "false: other"};
+        Label(&out, kOn[static_cast<int>(false_on[k])], cv::Point(box.x, box.br().y + 10),
+              cv::Scalar(255, 0, 255));
       }
       for (int id : missed_ids) {
         cv::rectangle(out, expected[id]->box, cv::Scalar(0, 0, 255), 2);
