@@ -227,6 +227,15 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   if (k_total == 0) return result;
   // The top level is seen from above (the camera is higher than any stack): each of its
   // objects shows a top face or cap, not just a thin upright face (a wall, a poster, a bar).
+  // A blob with sliver_fraction of its top level's groups such faces is not these objects;
+  // fewer, in a pile, are slivers of objects hidden behind others or cut by the image's edge:
+  // their pixels go to no piece (one sliver refused a pile of twenty cubes before).
+  std::vector<std::pair<int, cv::Point2f>> all_centres;  // (level, centre)
+  std::vector<uint8_t> sliver;                           // per centre: a thin top-level group
+  for (int level = 0; level < levels; ++level) {
+    for (const cv::Point2f& c : level_centres[level]) all_centres.emplace_back(level, c);
+  }
+  sliver.assign(all_centres.size(), 0);
   for (int level = levels - 1; level >= 0; --level) {
     const std::vector<cv::Point2f>& centres = level_centres[level];
     if (centres.empty()) continue;
@@ -238,23 +247,25 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
       }
       groups[best].push_back(q);
     }
-    for (const std::vector<cv::Point2f>& g : groups) {
+    size_t first = 0;  // the level's first centre in all_centres
+    for (int l = 0; l < level; ++l) first += level_centres[l].size();
+    int thin = 0;
+    for (size_t c = 0; c < groups.size(); ++c) {
+      const std::vector<cv::Point2f>& g = groups[c];
       if (g.size() < 3) continue;
       const cv::RotatedRect rect = cv::minAreaRect(g);
       // Cells are points at their centres: one cell more across.
       if (std::min(rect.size.width, rect.size.height) + options.cell_size < options.min_top_depth)
-        return result;
+        sliver[first + c] = 1, ++thin;
     }
+    if (thin > 0 && thin >= options.sliver_fraction * static_cast<int>(groups.size()))
+      return result;
     break;
   }
-  result.objects = k_total;
+  result.objects = k_total - static_cast<int>(std::count(sliver.begin(), sliver.end(), uint8_t{1}));
 
   // Every point to the nearest centre of its level (of any level when its own has none);
   // each group's pixels, grown back over the rim.
-  std::vector<std::pair<int, cv::Point2f>> all_centres;  // (level, centre)
-  for (int level = 0; level < levels; ++level) {
-    for (const cv::Point2f& c : level_centres[level]) all_centres.emplace_back(level, c);
-  }
   const int k = static_cast<int>(all_centres.size());
   std::vector<cv::Mat> group_masks(k);
   for (cv::Mat& g : group_masks) g = cv::Mat::zeros(mask.size(), CV_8UC1);
@@ -273,9 +284,13 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
     }
     group_masks[best].at<uint8_t>(pixels[i]) = 255;
   }
+  for (int c = 0; c < k; ++c) {
+    if (sliver[c]) group_masks[c].release();
+  }
   const cv::Mat grow = cv::getStructuringElement(
       cv::MORPH_ELLIPSE, cv::Size(2 * options.erode_px + 3, 2 * options.erode_px + 3));
   for (cv::Mat& g : group_masks) {
+    if (g.empty()) continue;  // a sliver's
     cv::morphologyEx(g, g, cv::MORPH_CLOSE, grow);
     cv::dilate(g, g, grow);
     g &= mask;

@@ -43,9 +43,18 @@ struct SizeSplitOptions {
   // face, with depth noise).
   double level_slack = 0.1;
   // The blob's top (its 97th percentile) within this x the object's height of a whole number
-  // of heights; each object of the top level at least min_top_depth widths deep on the floor.
+  // of heights; each object of the top level at least min_top_depth widths deep on the floor
+  // (seen from above, an object shows its top and its front: its whole depth, unless something
+  // hides part of it; a robot's bumper, 6 cm thick, shows 0.4 of a 15 cm cube's).
   double top_tolerance = 0.2;
-  double min_top_depth = 0.35;
+  double min_top_depth = 0.6;
+  // The same for round objects, which show only their front half (SplitBySize does not know
+  // the shape: the caller passes this as min_top_depth for them).
+  double min_top_depth_round = 0.35;
+  // A top level with at least this fraction of its groups thinner than min_top_depth is
+  // refused; fewer thin groups are slivers (objects hidden behind others, cut by the image's
+  // edge) whose pixels go to no piece. 0: a single thin group refuses the blob.
+  double sliver_fraction = 1.0 / 3.0;
   // The blob's bottom (its 3rd percentile) at most this x the object's height above the floor:
   // objects rest on it, so a blob raised off it is something else of their colour.
   double floor_tolerance = 0.5;

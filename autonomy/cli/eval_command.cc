@@ -31,6 +31,7 @@ struct EvalArgs {
   bool no_curvature_test = false;
   bool no_attach_test = false;
   bool no_float_test = false;
+  bool no_sliver_drop = false;
 };
 
 int RunVision(const EvalArgs& args) {
@@ -50,6 +51,7 @@ int RunVision(const EvalArgs& args) {
   if (args.no_curvature_test) options.detect.flat_curvature_ratio = 0.0;
   if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
   options.detect.drop_floating = !args.no_float_test;
+  if (args.no_sliver_drop) options.detect.size_split.sliver_fraction = 0.0;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
       throw std::invalid_argument("--pile MIN,MAX: MIN must not exceed MAX");
@@ -126,6 +128,10 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   vision->add_flag("--no-float-test", args->no_float_test,
                    "keep blobs held off the floor over nothing (the detector before the test, "
                    "for comparison)");
+  vision->add_flag("--no-sliver-drop", args->no_sliver_drop,
+                   "a thin group (a sliver of an object hidden or cut by the image's edge) "
+                   "refuses the split by size of its whole pile (the detector before, for "
+                   "comparison)");
   vision->add_option("--pictures", args->pictures,
                      "write annotated views of the 12 worst frames (detections, misses, false "
                      "and off-field detections) here");
