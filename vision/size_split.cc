@@ -103,8 +103,14 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   for (size_t i = 0; i < points.size(); ++i) heights[i] = points[i][2];
   double bottom = 0.0;
   const double height_units = TrimmedExtent(&heights, options.trim_fraction, &bottom);
-  if (height_units > extent.vertical_limit * std::max(1, extent.max_stack) ||
-      height_units < extent.min_vertical || bottom > options.floor_tolerance) {
+  // Objects whose sides are hidden show just their top faces: a flat blob at a whole number of
+  // object heights (the top check below), not a floor marking or a low bar.
+  const bool top_faces = options.top_faces && height_units < extent.min_vertical &&
+                         std::round(bottom) >= 1.0 &&
+                         std::round(bottom) <= std::max(1, extent.max_stack) &&
+                         std::abs(bottom - std::round(bottom)) <= options.top_tolerance;
+  if (!top_faces && (height_units > extent.vertical_limit * std::max(1, extent.max_stack) ||
+                     height_units < extent.min_vertical || bottom > options.floor_tolerance)) {
     return result;
   }
   // Objects rest on the floor or on one another, so the top of the blob lies at a whole

@@ -58,6 +58,10 @@ struct SizeSplitOptions {
   // The blob's bottom (its 3rd percentile) at most this x the object's height above the floor:
   // objects rest on it, so a blob raised off it is something else of their colour.
   double floor_tolerance = 0.5;
+  // ... unless the blob is flat and lies at a whole number of object heights (within
+  // top_tolerance, up to the tallest stack): the top faces of objects whose sides are hidden
+  // (some of Push Back's blocks in the arena views show nothing else).
+  bool top_faces = true;
   int min_level_points = 4;  // a stack level (or a part of one apart from the rest on the
                              // floor) with fewer footprint cells has no objects of its own
   // Footprint cells within this x the object's width of each other belong to one part of a

@@ -540,6 +540,47 @@ TEST(SurfaceCurvatureTest, ABallCurvesEveryWayAnEdgeAndANoodleDoNot) {
                    .has_value());
 }
 
+// A blob whose depth reads one flat surface (objects whose sides are hidden, or something
+// flat): at a whole number of object heights it is the top faces of objects, split by their
+// size (SizeSplitOptions::top_faces); between whole numbers (a low bar's top) it is not split,
+// and without the rule neither is. Drawn, not rendered: every pixel whose ray meets the plane
+// z = level x height inside two objects' footprints side by side (0.7-0.8 m ahead).
+TEST(SizeSplitTest, TopFacesAloneAreSplitByTheirSize) {
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  const CameraModel camera(robot.camera);
+  const double size = 0.081;  // Push Back's block
+  const ObjectExtent extent{size, size};
+  const Eigen::Vector3d origin = camera.CameraToRobot(Eigen::Vector3d::Zero());
+  // The raw reading for a corrected depth (CorrectDepthM is affine).
+  const double c0 = camera.CorrectDepthM(0.0), c1 = camera.CorrectDepthM(1000.0);
+  const auto flat = [&](double level, const SizeSplitOptions& options) {
+    const double z = level * size;
+    cv::Mat mask(robot.camera.height_px, robot.camera.width_px, CV_8UC1, cv::Scalar(0));
+    cv::Mat depth(mask.size(), CV_16UC1, cv::Scalar(0));
+    for (int v = 0; v < mask.rows; ++v) {
+      for (int u = 0; u < mask.cols; ++u) {
+        const Eigen::Vector3d ray = camera.CameraToRobot(camera.BackProject(u, v, 1.0)) - origin;
+        if (ray.z() >= 0.0) continue;
+        const double t = (z - origin.z()) / ray.z();  // camera depth at the plane
+        const Eigen::Vector3d p = origin + t * ray;
+        if (p.x() < 0.7 || p.x() > 0.7 + size || std::abs(p.y()) > size) continue;
+        mask.at<uint8_t>(v, u) = 255;
+        depth.at<uint16_t>(v, u) =
+            static_cast<uint16_t>(std::lround((t - c0) / (c1 - c0) * 1000.0));
+      }
+    }
+    const cv::Rect box = cv::boundingRect(mask);
+    EXPECT_GT(box.area(), 400) << "level " << level;
+    return SplitBySize(mask(box), depth(box), box.tl(), camera, extent, options).objects;
+  };
+  SizeSplitOptions without;
+  without.top_faces = false;
+  EXPECT_EQ(flat(1.0, {}), 2);
+  EXPECT_EQ(flat(1.0, without), 0);
+  EXPECT_EQ(flat(0.6, {}), 0);  // a low bar's top
+  EXPECT_EQ(flat(2.0, {}), 0);  // no stack of two is placed: max_stack 1
+}
+
 // The split alone: an empty or depthless blob gives no groups; one object, one group.
 TEST(SizeSplitTest, NoDepthMeansNoGroups) {
   const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
