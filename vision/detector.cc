@@ -248,6 +248,32 @@ std::vector<uint8_t> FloatingColumns(const cv::Mat& blob_mask, cv::Point offset,
   return floating;
 }
 
+// How tall `piece_mask` (at `offset`) stands, from its depth: the spread of its points'
+// heights in the robot frame between the 3rd and 97th percentiles (a rim pixel may read what
+// lies behind). 0 without readings.
+double StandingHeightM(const cv::Mat& piece_mask, cv::Point offset, const cv::Mat& depth_mm,
+                       const CameraModel& camera) {
+  thread_local std::vector<double> heights;
+  heights.clear();
+  for (int v = 0; v < piece_mask.rows; ++v) {
+    const uint8_t* m = piece_mask.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v + offset.y) + offset.x;
+    for (int u = 0; u < piece_mask.cols; ++u) {
+      if (!m[u] || !d[u]) continue;
+      heights.push_back(camera
+                            .CameraToRobot(camera.BackProject(u + offset.x, v + offset.y,
+                                                              camera.CorrectDepthM(d[u])))
+                            .z());
+    }
+  }
+  if (heights.size() < 8) return 0.0;
+  const size_t cut = static_cast<size_t>(0.03 * (heights.size() - 1));
+  std::nth_element(heights.begin(), heights.begin() + cut, heights.end());
+  const double low = heights[cut];
+  std::nth_element(heights.begin(), heights.end() - 1 - cut, heights.end());
+  return heights[heights.size() - 1 - cut] - low;
+}
+
 // How many times smaller the image K-Means clusters is (DetectOptions::kmeans_downsample).
 int KMeansFactor(const cv::Mat& bgr, const DetectOptions& options) {
   return options.kmeans_downsample > 0
@@ -950,6 +976,17 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             if (!best) {
               ++st.rejected_size;
               continue;
+            }
+            if (options.drop_too_tall && !by_size && !best->round) {
+              // Taller than the kind can stand, on its edge (its width) or in the tallest
+              // stack the season places: an upright bar or panel of its colour.
+              const double tallest = std::max(
+                  2.0 * best->radius_m, 2.0 * best->centre_height_m * std::max(1, best->max_stack));
+              if (StandingHeightM(piece_mask, roi.tl(), depth_mm, *setup.camera) >
+                  options.size_tolerance_vertical * tallest) {
+                ++st.rejected_size;
+                continue;
+              }
             }
             if (best->round && best->solid && options.min_bulge_ratio > 0.0) {
               // The bands at the kind's apparent radius at this depth, not the piece's own: a

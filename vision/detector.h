@@ -46,7 +46,12 @@ struct DetectOptions {
   bool split_piles_by_size = true;
   double size_tolerance_horizontal = 1.25;  // a group fits one object up to this x its width
   double size_tolerance_vertical = 1.3;     // ... and this x its height
-  double pile_area_ratio = 4.0;             // x the apparent area of one object
+  // With depth, a piece of a kind that is not round, not split off by size, whose points span
+  // in height more than size_tolerance_vertical x the tallest the kind stands (its width on its
+  // edge, or its tallest stack) is not one (High Stakes' upright blue and red bars taken for
+  // rings).
+  bool drop_too_tall = true;
+  double pile_area_ratio = 4.0;  // x the apparent area of one object
   SizeSplitOptions size_split;
   // Round kinds: a circle fitted to the blob's outline (not the image border or a cut) must
   // fit within this x its radius (rms) and cover at least this much of the circle.
