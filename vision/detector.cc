@@ -831,6 +831,10 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           split_options.link_fraction = 0.0;
           split_options.sliver_fraction = 0.0;
           split_options.min_top_depth = split_options.min_top_depth_round;
+          // Grown over each other, a pile's balls keep the pieces the bulge, curvature and
+          // attach tests were measured on (kept apart, more of Over Under's bumper pieces
+          // passed those tests, and its piles were counted worse).
+          split_options.exclusive_growth = false;
         }
         sized = SplitBySize(blob_mask, depth_mm(window), window.tl(), *setup.camera, *size_extent,
                             split_options);

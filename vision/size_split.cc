@@ -295,11 +295,19 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   }
   const cv::Mat grow = cv::getStructuringElement(
       cv::MORPH_ELLIPSE, cv::Size(2 * options.erode_px + 3, 2 * options.erode_px + 3));
+  // Grown back over the rim, a group stops at the pixels given to another
+  // (SizeSplitOptions::exclusive_growth).
+  cv::Mat assigned = cv::Mat::zeros(mask.size(), CV_8UC1);
+  for (const cv::Mat& g : group_masks) {
+    if (options.exclusive_growth && !g.empty()) assigned |= g;
+  }
+  cv::Mat free_for;  // its own buffer: assigning to a Mat that shares mask's would write there
   for (cv::Mat& g : group_masks) {
-    if (g.empty()) continue;  // a sliver's
+    if (g.empty()) continue;                                           // a sliver's
+    if (options.exclusive_growth) free_for = mask & ~(assigned & ~g);  // not the others' own
     cv::morphologyEx(g, g, cv::MORPH_CLOSE, grow);
     cv::dilate(g, g, grow);
-    g &= mask;
+    g &= options.exclusive_growth ? free_for : mask;
     std::vector<std::vector<cv::Point>> contours;
     FindOuterContours(g, &contours);
     if (contours.empty()) continue;

@@ -62,6 +62,10 @@ struct SizeSplitOptions {
   // top_tolerance, up to the tallest stack): the top faces of objects whose sides are hidden
   // (some of Push Back's blocks in the arena views show nothing else).
   bool top_faces = true;
+  // Each group, grown back over the blob's rim, stops at the pixels given to another group:
+  // grown over them, neighbouring pieces overlapped (a second detection on one object, or one
+  // spanning two: most of Skyrise's and Push Back's "pieces").
+  bool exclusive_growth = true;
   int min_level_points = 4;  // a stack level (or a part of one apart from the rest on the
                              // floor) with fewer footprint cells has no objects of its own
   // Footprint cells within this x the object's width of each other belong to one part of a

@@ -234,6 +234,27 @@ TEST(VisionEvalTest, UprightBarsAreNotTakenForRings) {
   EXPECT_LT(other, 0.6 * other_without);
 }
 
+// The groups split off by size are grown back over the blob's rim only onto pixels no other
+// group holds (SizeSplitOptions::exclusive_growth): overlapping, neighbouring pieces made a
+// second detection on one object or one spanning two. Measured on these 20 Skyrise arena
+// views: false detections on pieces of objects 199 -> 142 over the six methods, precision
+// +0.017 to +0.026 per method, the same objects found; the test asks for a fifth fewer,
+// precision up and the same objects found, per method.
+TEST(VisionEvalTest, PiecesSplitBySizeDoNotOverlap) {
+  VisionEvalOptions without;
+  without.detect.size_split.exclusive_growth = false;
+  int pieces = 0, pieces_without = 0;
+  CompareInArena("skyrise", 20, {}, without,
+                 [&](const VisionMethodScore& a, const VisionMethodScore& b) {
+                   EXPECT_GT(a.Precision(), b.Precision());
+                   EXPECT_EQ(a.found, b.found);
+                   pieces += a.false_pieces;
+                   pieces_without += b.false_pieces;
+                 });
+  EXPECT_GT(pieces_without, 150);
+  EXPECT_LT(pieces, 0.8 * pieces_without);
+}
+
 // Piles (#16 item 4): `--pile 10,30` puts a heap of touching blocks in every view; split by
 // their known size they are counted, without it hardly at all. Measured with `slamo eval
 // vision --season push_back --frames 6 --seed 1 --pile 10,30 [--no-size-split]`,
