@@ -819,6 +819,40 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         }
       }
       SizeSplitResult sized;
+      // Solid balls of one size (spheres, and triballs, which are near enough) are counted by
+      // their centres; other kinds of the colour (a semi-transparent ball) may share the blob,
+      // which the balls then do not explain (SplitSpheres finds none).
+      const TargetKind* ball_kind = nullptr;
+      if (options.split_spheres && blob_depth_m > 0.0) {
+        for (const TargetKind& k : kinds) {
+          if (!k.solid || !k.round) continue;
+          if (ball_kind && std::abs(k.radius_m - ball_kind->radius_m) > 0.1 * ball_kind->radius_m) {
+            ball_kind = nullptr;
+            break;
+          }
+          if (!ball_kind) ball_kind = &k;
+        }
+      }
+      // A blob that fills its convex hull is one ball (or a ball with a sliver of one behind);
+      // so is one no larger than a ball and a tenth looks at its depth.
+      if (ball_kind) {
+        const double ball_px =
+            focal * ball_kind->radius_m / (blob_depth_m + ball_kind->surface_to_centre_m);
+        if (blob_area < options.sphere_split_min_area * M_PI * ball_px * ball_px ||
+            blob_area >= options.single_object_solidity * ConvexHullArea(blob, blob_box))
+          ball_kind = nullptr;
+      }
+      if (ball_kind) {
+        SphereSplitResult balls =
+            SplitSpheres(blob_mask, depth_mm(window), window.tl(), *setup.camera,
+                         ball_kind->radius_m, options.sphere_split);
+        if (balls.objects > 1) {
+          ++st.split_spheres;
+          sized.objects = balls.objects;
+          sized.pieces = std::move(balls.pieces);
+          size_extent.reset();
+        }
+      }
       if (size_extent) {
         // Piles of round objects are clustered whole: a ball half hidden behind another shows
         // a cap whose footprint lies apart from the front ball's crescent, and taking the

@@ -18,6 +18,7 @@
 #include "vision/measurement.h"
 #include "vision/separation.h"
 #include "vision/size_split.h"
+#include "vision/sphere_split.h"
 
 namespace slamo::vision {
 
@@ -53,6 +54,12 @@ struct DetectOptions {
   bool drop_too_tall = true;
   double pile_area_ratio = 4.0;  // x the apparent area of one object
   SizeSplitOptions size_split;
+  // With depth, blobs of a colour whose solid round kinds (spheres, triballs) are of one size
+  // are split by the balls' centres (vision/sphere_split.h) when two or more are found; one
+  // or none leaves the blob to the paths above.
+  bool split_spheres = true;
+  double sphere_split_min_area = 1.1;  // ... for blobs larger than this x one ball's area
+  SphereSplitOptions sphere_split;
   // Round kinds: a circle fitted to the blob's outline (not the image border or a cut) must
   // fit within this x its radius (rms) and cover at least this much of the circle.
   double max_arc_rms_ratio = 0.1;
@@ -159,7 +166,7 @@ struct Detection {
   double score = 0.0;  // circularity x fill of the enclosing circle, 0..1
   std::vector<cv::Point> contour;
   bool split = false;  // came from separating a blob of touching objects
-  bool sized = false;  // ... by the objects' known size (vision/size_split.h)
+  bool sized = false;  // ... by the objects' known size (size_split.h, sphere_split.h)
   std::optional<Measurement> measurement;
 };
 
@@ -171,6 +178,7 @@ struct DetectStats {
   int rejected_size = 0;
   int rejected_flat = 0;      // round solid kinds whose surface does not curve (a bumper's face)
   int split_by_size = 0;      // blobs separated by the objects' known size
+  int split_spheres = 0;      // blobs separated by the centres of balls of one size
   int rejected_floating = 0;  // blobs with a part held off the floor over nothing (cleared)
   int rejected_attached = 0;  // pieces whose top runs on into a taller body (a bumper's chassis)
   int without_depth = 0;      // kept, but no range: no valid depth on them (or, without a depth

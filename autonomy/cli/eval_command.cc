@@ -27,6 +27,7 @@ struct EvalArgs {
   double pose_sigma_m = 0.05;
   std::vector<int> pile;  // MIN,MAX
   bool no_size_split = false;
+  bool no_sphere_split = false;
   bool no_bulge_test = false;
   bool no_curvature_test = false;
   bool no_attach_test = false;
@@ -47,6 +48,7 @@ int RunVision(const EvalArgs& args) {
   options.max_range_m = args.max_range_m;
   options.pose_sigma_m = args.pose_sigma_m;
   options.detect.split_by_size = !args.no_size_split;
+  options.detect.split_spheres = !args.no_sphere_split;
   if (args.no_bulge_test) options.detect.min_bulge_ratio = 0.0;
   if (args.no_curvature_test) options.detect.flat_curvature_ratio = 0.0;
   if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
@@ -115,6 +117,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
       ->check(CLI::Range(1, 200));
   vision->add_flag("--no-size-split", args->no_size_split,
                    "separate without the objects' known size (the detector before it, for "
+                   "comparison)");
+  vision->add_flag("--no-sphere-split", args->no_sphere_split,
+                   "separate touching balls without their centres (the detector before it, for "
                    "comparison)");
   vision->add_flag("--no-bulge-test", args->no_bulge_test,
                    "keep round detections whose surface does not curve away (the detector "

@@ -39,11 +39,13 @@ const Scene& SceneAt(int width) {
   return scenes.emplace(width, std::move(scene)).first->second;
 }
 
-void BM_Detect(benchmark::State& state, DetectMethod method, SeparationMethod separation) {
+void BM_Detect(benchmark::State& state, DetectMethod method, SeparationMethod separation,
+               bool split_spheres = true) {
   const Scene& scene = SceneAt(static_cast<int>(state.range(0)));
   DetectOptions options;
   options.method = method;
   options.separation = separation;
+  options.split_spheres = split_spheres;
   size_t found = 0;
   for (auto _ : state) {
     const std::vector<Detection> detections =
@@ -78,6 +80,11 @@ BENCHMARK_CAPTURE(BM_Detect, threshold_defects, DetectMethod::kThreshold,
                   SeparationMethod::kConcaveDefects)
     ->Arg(512)
     ->Arg(1920)
+    ->Unit(benchmark::kMillisecond);
+// What the split of touching balls by their centres costs (vision/sphere_split.h).
+BENCHMARK_CAPTURE(BM_Detect, threshold_defects_without_sphere_split, DetectMethod::kThreshold,
+                  SeparationMethod::kConcaveDefects, false)
+    ->Arg(512)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Detect, threshold_watershed, DetectMethod::kThreshold,
                   SeparationMethod::kWatershed)

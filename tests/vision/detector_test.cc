@@ -141,14 +141,19 @@ TEST_F(DetectorTest, TwoTouchingBallsAreSplit) {
   const platform::RgbdFrame frame = Render(pose_);
   DetectOptions options;
   options.separation = SeparationMethod::kNone;
+  options.split_spheres = false;
   // Unsplit, the pair is one blob that is not round: no detection at all.
   EXPECT_TRUE(DetectColour(frame, "red", options).empty());
-  options.separation = SeparationMethod::kConcaveDefects;
-  const std::vector<Detection> split = DetectColour(frame, "red", options);
-  ASSERT_EQ(split.size(), 2u);
-  for (const Detection& d : split) {
-    ASSERT_TRUE(d.measurement.has_value());
-    EXPECT_NEAR(std::abs(d.measurement->position_robot_m.y()), 0.0635, 0.03);
+  // Cut at its concave defects (the thesis), or found by the balls' centres whatever the cut.
+  for (const bool by_centres : {false, true}) {
+    options.separation = by_centres ? SeparationMethod::kNone : SeparationMethod::kConcaveDefects;
+    options.split_spheres = by_centres;
+    const std::vector<Detection> split = DetectColour(frame, "red", options);
+    ASSERT_EQ(split.size(), 2u) << (by_centres ? "by centres" : "by defects");
+    for (const Detection& d : split) {
+      ASSERT_TRUE(d.measurement.has_value());
+      EXPECT_NEAR(std::abs(d.measurement->position_robot_m.y()), 0.0635, 0.03);
+    }
   }
 }
 
