@@ -13,8 +13,7 @@ namespace slamo::vision {
 
 SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
                                const CameraModel& camera, double radius_m,
-                               const SphereSplitOptions& options_in) {
-  SphereSplitOptions options = options_in;
+                               const SphereSplitOptions& options) {
   SphereSplitResult result;
   const double r = radius_m;
   if (mask.empty() || !(r > 0.0)) return result;
@@ -65,16 +64,12 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
   for (int v = 0; v < core.rows; ++v) {
     const uint8_t* m = core.ptr<uint8_t>(v);
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
-    const double y_over_z = (v + offset.y - intrinsics.cy) / intrinsics.fy;
     for (int u = 0; u < core.cols; ++u) {
       if (!m[u] || !d[u]) continue;
       const double z = camera.CorrectDepthM(d[u]);
       if (!(z > 0.0)) continue;
       ++with_depth;
-      const Eigen::Vector3d p =
-          eye +
-          robot_from_camera *
-              Eigen::Vector3d((u + offset.x - intrinsics.cx) / intrinsics.fx * z, y_over_z * z, z);
+      const Eigen::Vector3d p = robot_point(u, v, z);
       if (p.z() < -tol || p.z() > 2.0 * r + tol) {
         const size_t cm = static_cast<size_t>(z * 100.0);
         if (cm >= slack_at_cm.size()) slack_at_cm.resize(cm + 1, -1.0);
