@@ -873,6 +873,11 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         sized = SplitBySize(blob_mask, depth_mm(window), window.tl(), *setup.camera, *size_extent,
                             split_options);
         if (sized.objects > 1) ++st.split_by_size;
+        // What follows (the defect cut, the shape tests, the measurement) sees the blob
+        // without its rim, as it was measured with.
+        if (split_options.erode_px > 0) {
+          cv::erode(blob_mask, blob_mask, cv::Mat(), cv::Point(-1, -1), split_options.erode_px);
+        }
       }
       const bool convex =
           sized.objects == 1 ||

@@ -70,10 +70,13 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   SizeSplitResult result;
   if (mask.empty() || extent.width_m <= 0.0 || extent.height_m <= 0.0) return result;
   // Points: the blob without its rim, where depth may read what lies behind the object.
-  cv::Mat core = mask;
+  // (A new matrix: eroded into `core` sharing `mask`'s pixels, the caller's blob shrank too.)
+  cv::Mat core;
   if (options.erode_px > 0) {
     cv::erode(mask, core, cv::Mat(), cv::Point(-1, -1), options.erode_px);
     if (cv::countNonZero(core) < 16) core = mask;
+  } else {
+    core = mask;
   }
   std::vector<cv::Point> pixels;
   std::vector<cv::Vec3f> points;  // robot frame, in units of the object's width and height

@@ -113,24 +113,26 @@ TEST(VisionEvalTest, StarsAreFoundWholeOnlyWithTheSizeRule) {
 
 // Round solid kinds must curve away from the camera (DetectOptions::min_bulge_ratio): in the
 // Over Under arena the opponents' red and blue bumpers, cut into triball-sized pieces, are
-// flat and dropped. Measured with `slamo eval vision --season over_under --arena --frames 10
-// --seed 1 [--no-bulge-test]`: precision +0.105 to +0.33 per method, recall the same but for
-// kmeans+defects (0.833 -> 0.778, one triball of 18); the test asks for +0.1 and -0.06. Both
-// without the sphere split that came after it (DetectOptions::split_spheres), whose own
-// curvature test drops many of the same pieces: with it, the bulge test adds +0.07 precision
-// for threshold+watershed and threshold+none.
+// flat and dropped. Measured with `slamo eval vision --season over_under --arena --frames 20
+// --seed 1 --no-sphere-split [--no-bulge-test]`: precision +0.093 (threshold+defects, 0.807 ->
+// 0.900) to +0.239 (kmeans+watershed, 0.736 -> 0.975) per method, recall the same or 0.022
+// lower (one triball of 45); the test asks for +0.08 and -0.04. Without the sphere split that
+// came after it (DetectOptions::split_spheres), whose own curvature test drops some of the same
+// pieces: with it, the bulge test adds +0.076 to +0.183. (On the first 10 of these views, since
+// the split by size no longer shrinks the blob it is given, threshold+watershed and
+// threshold+none keep the same one false detection with the test or without.)
 TEST(VisionEvalTest, FlatFacesAreNotTakenForRoundObjects) {
   VisionEvalOptions with;
   with.detect.split_spheres = false;
   VisionEvalOptions without = with;
   without.detect.min_bulge_ratio = 0.0;
-  const std::vector<VisionMethodScore> with_test = Scores("over_under", 10, 1, true, with);
-  const std::vector<VisionMethodScore> without_test = Scores("over_under", 10, 1, true, without);
+  const std::vector<VisionMethodScore> with_test = Scores("over_under", 20, 1, true, with);
+  const std::vector<VisionMethodScore> without_test = Scores("over_under", 20, 1, true, without);
   ASSERT_EQ(with_test.size(), without_test.size());
   for (size_t k = 0; k < with_test.size(); ++k) {
     SCOPED_TRACE(with_test[k].name);
-    EXPECT_GT(with_test[k].Precision(), without_test[k].Precision() + 0.1);
-    EXPECT_GE(with_test[k].Recall(), without_test[k].Recall() - 0.06);
+    EXPECT_GT(with_test[k].Precision(), without_test[k].Precision() + 0.08);
+    EXPECT_GE(with_test[k].Recall(), without_test[k].Recall() - 0.04);
   }
 }
 
@@ -179,9 +181,11 @@ TEST(VisionEvalTest, BumpersOffTheFloorAreNotTakenForRings) {
 // Round kinds must curve in every direction (DetectOptions::flat_curvature_ratio): pieces of
 // an opponent's bumper running diagonally in the image, which the bulge test's row and column
 // bands take for triballs, are dropped. Measured with `slamo eval vision --season over_under
-// --arena --frames 50 --seed 1 [--no-curvature-test]`: false detections on robots 159 -> 103
-// over the six methods. Both without the attach test that came after it (below), which drops
-// many of the same pieces.
+// --arena --frames 50 --seed 1 --no-attach-test [--no-curvature-test]`: false detections on
+// robots 156 -> 118 over the six methods (159 -> 103 when the split by size still shrank the
+// blob it was given), precision up for each, the same triballs found; the test asks for a fifth
+// fewer. Both without the attach test that came after it (below), which drops many of the same
+// pieces.
 TEST(VisionEvalTest, BumperPiecesFlatAlongTheirLengthAreNotTakenForTriballs) {
   VisionEvalOptions with;
   with.detect.attach_margin_ratio = 0.0;
@@ -192,7 +196,7 @@ TEST(VisionEvalTest, BumperPiecesFlatAlongTheirLengthAreNotTakenForTriballs) {
         EXPECT_GT(a.Precision(), b.Precision());
       });
   EXPECT_GT(r.on_robots_without, 100);
-  EXPECT_LT(r.on_robots, 0.75 * r.on_robots_without);
+  EXPECT_LT(r.on_robots, 0.8 * r.on_robots_without);
   EXPECT_GE(r.found, r.found_without - 2);
 }
 
@@ -269,8 +273,9 @@ TEST(VisionEvalTest, UprightBarsAreNotTakenForRings) {
 // The groups split off by size are grown back over the blob's rim only onto pixels no other
 // group holds (SizeSplitOptions::exclusive_growth): overlapping, neighbouring pieces made a
 // second detection on one object or one spanning two. Measured on these 20 Skyrise arena
-// views: false detections on pieces of objects 199 -> 142 over the six methods, precision
-// +0.017 to +0.026 per method, the same objects found; the test asks for a fifth fewer,
+// views: false detections on pieces of objects 187 -> 154 over the six methods (199 -> 142
+// when the split by size still shrank the blob it was given, and the pieces grew over less),
+// precision up for each method, the same objects found; the test asks for a seventh fewer,
 // precision up and the same objects found, per method.
 TEST(VisionEvalTest, PiecesSplitBySizeDoNotOverlap) {
   VisionEvalOptions without;
@@ -281,7 +286,7 @@ TEST(VisionEvalTest, PiecesSplitBySizeDoNotOverlap) {
         EXPECT_EQ(a.found, b.found);
       });
   EXPECT_GT(r.on_pieces_without, 150);
-  EXPECT_LT(r.on_pieces, 0.8 * r.on_pieces_without);
+  EXPECT_LT(7 * r.on_pieces, 6 * r.on_pieces_without);
 }
 
 // Piles (#16 item 4): `--pile 10,30` puts a heap of touching blocks in every view; split by
