@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include <opencv2/imgproc.hpp>
@@ -62,6 +63,53 @@ std::vector<int> FootprintComponents(const std::vector<cv::Point2f>& cells, doub
   return label;
 }
 
+// Whether the blob's lower edge is hidden: in at least `fraction` of its columns, the pixels
+// just under it (up to `reach_px` rows) see something standing above the floor (higher than
+// `min_height_m`) at least `min_gap_m` nearer the camera, on the floor, than the blob's lowest
+// point there. `depth_mm` is a view into the whole depth image (read beyond its rows).
+bool LowerEdgeHidden(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
+                     const CameraModel& camera, int reach_px, double min_height_m, double min_gap_m,
+                     double fraction) {
+  cv::Mat below = depth_mm;  // the same pixels, with the rows under it
+  below.adjustROI(0, reach_px + 1, 0, 0);
+  const Eigen::Vector3d eye = camera.CameraToRobot(Eigen::Vector3d::Zero());
+  const auto robot_point = [&](int u, int v, uint16_t raw) -> std::optional<Eigen::Vector3d> {
+    if (raw == 0) return std::nullopt;  // no reading
+    const double z = camera.CorrectDepthM(raw);
+    if (!(z > 0.0)) return std::nullopt;
+    return camera.CameraToRobot(camera.BackProject(u + offset.x, v + offset.y, z));
+  };
+  int columns = 0, hidden = 0;
+  for (int u = 0; u < mask.cols; ++u) {
+    int lowest = -1;
+    for (int v = mask.rows - 1; v >= 0; --v) {
+      if (mask.at<uint8_t>(v, u)) {
+        lowest = v;
+        break;
+      }
+    }
+    if (lowest < 0) continue;
+    ++columns;
+    // The blob's lowest point with a reading in this column (its rim may read past it).
+    std::optional<Eigen::Vector3d> own;
+    for (int v = lowest; v >= std::max(0, lowest - 3) && !own; --v) {
+      if (mask.at<uint8_t>(v, u)) own = robot_point(u, v, depth_mm.at<uint16_t>(v, u));
+    }
+    if (!own) continue;
+    const double own_range = std::hypot(own->x() - eye.x(), own->y() - eye.y());
+    const int last = std::min(below.rows - 1, lowest + reach_px);
+    for (int v = lowest + 1; v <= last; ++v) {
+      const std::optional<Eigen::Vector3d> p = robot_point(u, v, below.at<uint16_t>(v, u));
+      if (p && p->z() > min_height_m &&
+          std::hypot(p->x() - eye.x(), p->y() - eye.y()) < own_range - min_gap_m) {
+        ++hidden;
+        break;
+      }
+    }
+  }
+  return columns > 0 && hidden >= fraction * columns;
+}
+
 }  // namespace
 
 SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
@@ -100,8 +148,9 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   // Taller than the tallest stack, or flatter than one object: not objects of this size.
   // Nor a blob whose bottom is off the floor: a raised structure of the objects' colour (a
   // goal's frame, a bar) seen from the side is not a pile. A trade-off: piles off the floor
-  // (rings on a stake, blocks in a raised goal, balls on a stash) or whose lower part is hidden
-  // (behind a barrier, below the image) are not split by size either.
+  // (rings on a stake, blocks in a raised goal, balls on a stash) or whose lower part is below
+  // the image are not split by size either; those whose lower part is hidden behind something
+  // nearer (a low bar) are (LowerEdgeHidden).
   std::vector<float> heights(points.size());
   for (size_t i = 0; i < points.size(); ++i) heights[i] = points[i][2];
   double bottom = 0.0;
@@ -112,25 +161,51 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
                          std::round(bottom) >= 1.0 &&
                          std::round(bottom) <= std::max(1, extent.max_stack) &&
                          std::abs(bottom - std::round(bottom)) <= options.top_tolerance;
-  if (!top_faces && (height_units > extent.vertical_limit * std::max(1, extent.max_stack) ||
-                     height_units < extent.min_vertical || bottom > options.floor_tolerance)) {
+  if (height_units > extent.vertical_limit * std::max(1, extent.max_stack)) return result;
+  // A blob whose lower edge is hidden (behind a low bar) may show only the upper part of its
+  // objects: its bottom is not where they rest.
+  const auto lower_edge_hidden = [&] {
+    if (options.hidden_fraction <= 0.0) return false;
+    double depth_m = 0.0;  // the blob's typical depth, for the reach in rows
+    {
+      std::vector<float> zs;
+      for (const cv::Point& p : pixels)
+        zs.push_back(camera.CorrectDepthM(depth_mm.at<uint16_t>(p)));
+      std::nth_element(zs.begin(), zs.begin() + zs.size() / 2, zs.end());
+      depth_m = zs[zs.size() / 2];
+    }
+    const int reach = std::max(3, static_cast<int>(std::ceil(camera.config().fy * extent.height_m /
+                                                             std::max(depth_m, 0.1))));
+    return LowerEdgeHidden(mask, depth_mm, offset, camera, reach,
+                           options.hidden_min_height * extent.height_m,
+                           options.hidden_min_gap * extent.width_m, options.hidden_fraction);
+  };
+  const bool bottom_hidden =
+      !top_faces && (height_units < extent.min_vertical || bottom > options.floor_tolerance) &&
+      bottom < options.hidden_max_bottom && lower_edge_hidden();
+  if (!top_faces && !bottom_hidden &&
+      (height_units < extent.min_vertical || bottom > options.floor_tolerance)) {
     return result;
   }
   // Objects rest on the floor or on one another, so the top of the blob lies at a whole
   // number of object heights (a robot's bumper, 0.02-0.14 m, does not for rings or blocks).
+  double top_units = 0.0;
   {
     const size_t top_rank =
         heights.size() - 1 - static_cast<size_t>(options.trim_fraction * (heights.size() - 1));
     std::nth_element(heights.begin(), heights.begin() + top_rank, heights.end());
-    const double top = heights[top_rank];
-    if (std::round(top) < 1.0 || std::abs(top - std::round(top)) > options.top_tolerance)
+    top_units = heights[top_rank];
+    if (std::round(top_units) < 1.0 ||
+        std::abs(top_units - std::round(top_units)) > options.top_tolerance)
       return result;
   }
 
   // Objects rest on the floor or on one another: a point's level in a stack is the number of
   // object heights below it (a top face, at the height of the object it covers, belongs to
   // that object: hence the slack).
-  const int levels = std::max(1, static_cast<int>(std::ceil(height_units - options.level_slack)));
+  // (A blob with a hidden lower edge: as many levels as its top stands object heights high.)
+  int levels = std::max(1, static_cast<int>(std::ceil(height_units - options.level_slack)));
+  if (bottom_hidden) levels = std::max(levels, static_cast<int>(std::lround(top_units)));
   const auto level_of = [&](const cv::Vec3f& q) {
     return std::clamp(static_cast<int>(std::floor(q[2] - options.level_slack)), 0, levels - 1);
   };

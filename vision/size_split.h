@@ -62,6 +62,18 @@ struct SizeSplitOptions {
   // top_tolerance, up to the tallest stack): the top faces of objects whose sides are hidden
   // (some of Push Back's blocks in the arena views show nothing else).
   bool top_faces = true;
+  // ... or unless its lower edge is hidden: in at least this fraction of its columns, the
+  // pixels under it (up to an object's height) see something standing higher than
+  // hidden_min_height x the object's height, nearer the camera by hidden_min_gap x its width
+  // (a low bar the objects lie behind; a ring of another colour under a ring is no nearer).
+  // Such a blob may show only its objects' upper parts: its bottom must lie below
+  // hidden_max_bottom x the object's height (what hides it is lower than the objects; with it
+  // at any height, blocks in Push Back's raised long goals, behind the goal's tube, were cut
+  // into a stack of six). 0: never.
+  double hidden_fraction = 0.5;
+  double hidden_min_height = 0.25;
+  double hidden_min_gap = 0.25;
+  double hidden_max_bottom = 1.0;
   // Each group, grown back over the blob's rim, stops at the pixels given to another group:
   // grown over them, neighbouring pieces overlapped (a second detection on one object, or one
   // spanning two: most of Skyrise's and Push Back's "pieces").

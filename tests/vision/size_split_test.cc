@@ -356,6 +356,49 @@ TEST(SizeSplitTest, ABlobOffTheFloorIsNotSplitBySize) {
   }
 }
 
+// Objects whose lower part is hidden behind something nearer are split by size too
+// (SizeSplitOptions::hidden_fraction): Push Back's four red blocks in a row in the blue park
+// zone, behind its 5 cm front bar (blue), seen across the bar from 0.8, 1.2 and 1.6 m, head on
+// and at 20 degrees. Measured: 23 of the 24 blocks that show found, none twice (at 1.2 m head
+// on, 3 of 4); without the rule 2 (the blob, too large for one block, is dropped). The test
+// asks for 22, none twice, and at most 4 without. (The lifted piles of
+// ABlobOffTheFloorIsNotSplitBySize, above, still are not split: under them is the floor.)
+TEST(SizeSplitTest, BlocksBehindALowBarAreSplitBySize) {
+  int visible_sum = 0, found = 0, found_without = 0;
+  for (double range : {0.8, 1.2, 1.6}) {
+    for (double bearing : {0.0, 0.35}) {
+      SizeSplitScene scene("push_back");
+      const field::ObjectType& block = scene.Type("block");
+      std::set<int> ids;
+      for (int k = 0; k < 4; ++k) {
+        platform::SimObject o;
+        o.id = k + 1;
+        o.type = &block;
+        o.colour = "red";
+        o.center_m = Eigen::Vector3d(1.428, -0.123 + 0.082 * k, block.height_m / 2.0);
+        scene.world()->objects.push_back(o);
+        ids.insert(o.id);
+      }
+      SCOPED_TRACE("range " + std::to_string(range) + " m, bearing " + std::to_string(bearing));
+      const Pose2D pose = Facing(Eigen::Vector2d(1.428, 0.0), range, bearing);
+      int visible = 0;
+      const auto on = scene.DetectionsOn(pose, "red", ids, nullptr, &visible);
+      EXPECT_EQ(visible, 4);
+      visible_sum += visible;
+      found += static_cast<int>(on.size());
+      for (const auto& [id, count] : on) EXPECT_EQ(count, 1) << "block " << id;
+      DetectOptions without;
+      without.size_split.hidden_fraction = 0.0;
+      for (const auto& [id, count] :
+           scene.DetectionsOn(pose, "red", ids, nullptr, nullptr, without))
+        found_without += count;
+    }
+  }
+  EXPECT_EQ(visible_sum, 24);
+  EXPECT_GE(found, 22);
+  EXPECT_LE(found_without, 4);
+}
+
 // A lone green triball `range_m` ahead of the thesis camera, rendered with its noise, and the
 // pixels it covers.
 platform::RgbdFrame RenderedTriball(const field::SeasonConfig& season,
