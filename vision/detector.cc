@@ -833,6 +833,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           if (!ball_kind) ball_kind = &k;
         }
       }
+      // Tried again on a piece of the cut that is no ball (below), whatever the blob.
+      const TargetKind* const piece_ball_kind = options.split_sphere_pieces ? ball_kind : nullptr;
       // A blob that fills its convex hull is one ball (or a ball with a sliver of one behind);
       // so is one no larger than a ball and a tenth looks at its depth.
       if (ball_kind) {
@@ -925,13 +927,18 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
         DilateLike(outline, cv::Mat(), &outline);  // 3x3: a piece's outline may shift by a pixel
       }
-      for (std::vector<cv::Point> piece : separated.pieces) {
+      // Pieces from a piece of the cut that no circle fits, split by the balls' centres, are
+      // appended from here on.
+      const size_t first_ball_piece = separated.pieces.size();
+      for (size_t piece_index = 0; piece_index < separated.pieces.size(); ++piece_index) {
+        std::vector<cv::Point> piece = separated.pieces[piece_index];
+        const bool piece_sized = by_size || piece_index >= first_ball_piece;
         ++st.pieces;
         for (cv::Point& p : piece) p += window.tl();
         Detection d;
         d.colour = colour.name;
-        d.split = split;
-        d.sized = by_size;
+        d.split = split || piece_sized;
+        d.sized = piece_sized;
         d.area_px = cv::contourArea(piece);
         if (d.area_px < options.min_area_px) {
           ++st.rejected_small;
@@ -940,7 +947,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         const double perimeter = cv::arcLength(piece, true);
         d.circularity = perimeter > 0.0 ? 4.0 * M_PI * d.area_px / (perimeter * perimeter) : 0.0;
         d.box = cv::boundingRect(piece);
-        if (all_round && !by_size) {
+        if (all_round && !piece_sized) {
           // Round objects: a circle through the visible arcs of the outline gives the centre
           // and radius even when a cut, another object or the image border hides part of it.
           std::vector<cv::Point> arc;
@@ -956,6 +963,29 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               fit->rms > options.max_arc_rms_ratio * fit->radius ||
               fit->coverage_deg < options.min_arc_coverage_deg ||
               fit->radius > 2.0 * std::sqrt(d.area_px / M_PI) + 2.0) {
+            // Two balls or more that the cut left together (one behind another, or beside
+            // a larger object of their colour the whole blob's split could not explain).
+            const double piece_ball_px =
+                piece_ball_kind ? focal * piece_ball_kind->radius_m /
+                                      (blob_depth_m + piece_ball_kind->surface_to_centre_m)
+                                : 0.0;
+            if (piece_ball_kind && have_depth &&
+                d.area_px >= options.sphere_split_min_area * M_PI * piece_ball_px * piece_ball_px) {
+              const cv::Rect bounds =
+                  (d.box + cv::Size(4, 4) - cv::Point(2, 2)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+              cv::Mat piece_mask(bounds.size(), CV_8UC1, cv::Scalar(0));
+              FillOutline(piece, -bounds.tl(), &piece_mask);
+              SphereSplitResult balls =
+                  SplitSpheres(piece_mask, depth_mm(bounds), bounds.tl(), *setup.camera,
+                               piece_ball_kind->radius_m, options.sphere_split);
+              if (balls.objects > 1) {
+                ++st.split_spheres;
+                for (std::vector<cv::Point>& ball : balls.pieces) {
+                  for (cv::Point& p : ball) p += bounds.tl() - window.tl();
+                  separated.pieces.push_back(std::move(ball));
+                }
+              }
+            }
             ++st.rejected_shape;
             continue;
           }
@@ -965,7 +995,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               std::clamp(1.0 - fit->rms / (options.max_arc_rms_ratio * fit->radius), 0.0, 1.0) *
               std::min(1.0, fit->coverage_deg / 360.0 + 0.25);
         } else {
-          if (!by_size && d.circularity < min_circularity) {
+          if (!piece_sized && d.circularity < min_circularity) {
             ++st.rejected_shape;
             continue;
           }
@@ -982,7 +1012,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           const cv::Rect roi = (d.box + cv::Size(2 * pad, 2 * pad) - cv::Point(pad, pad)) &
                                cv::Rect(0, 0, bgr.cols, bgr.rows);
           cv::Mat piece_mask;
-          if (whole && blob_mask_is_fill && roi == window) {
+          if (whole && !piece_sized && blob_mask_is_fill && roi == window) {
             piece_mask = blob_mask;  // the same contour filled in the same window: no redraw
           } else {
             piece_mask = cv::Mat(roi.size(), CV_8UC1, cv::Scalar(0));
@@ -1008,7 +1038,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             // A piece split off by size is an object: only its kind is in question.
             const TargetKind* best = nullptr;
             double best_ratio =
-                by_size ? std::numeric_limits<double>::infinity() : options.size_tolerance;
+                piece_sized ? std::numeric_limits<double>::infinity() : options.size_tolerance;
             for (const TargetKind& k : kinds) {
               if (k.radius_m <= 0.0) continue;
               const double expected =
@@ -1020,7 +1050,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               ++st.rejected_size;
               continue;
             }
-            if (options.drop_too_tall && !by_size && !best->round) {
+            if (options.drop_too_tall && !piece_sized && !best->round) {
               // Taller than the kind can stand, on its edge (its width) or in the tallest
               // stack the season places: an upright bar or panel of its colour.
               const double tallest = std::max(

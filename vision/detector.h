@@ -59,6 +59,9 @@ struct DetectOptions {
   // or none leaves the blob to the paths above.
   bool split_spheres = true;
   double sphere_split_min_area = 1.1;  // ... for blobs larger than this x one ball's area
+  // ... and, whatever the blob, a piece of the cut that no circle fits is split by the balls'
+  // centres in it (two buckyballs one behind another beside Toss Up's large ball).
+  bool split_sphere_pieces = true;
   SphereSplitOptions sphere_split;
   // Round kinds: a circle fitted to the blob's outline (not the image border or a cut) must
   // fit within this x its radius (rms) and cover at least this much of the circle.

@@ -28,6 +28,7 @@ struct EvalArgs {
   std::vector<int> pile;  // MIN,MAX
   bool no_size_split = false;
   bool no_sphere_split = false;
+  bool no_sphere_pieces = false;
   bool no_bulge_test = false;
   bool no_curvature_test = false;
   bool no_attach_test = false;
@@ -49,6 +50,7 @@ int RunVision(const EvalArgs& args) {
   options.pose_sigma_m = args.pose_sigma_m;
   options.detect.split_by_size = !args.no_size_split;
   options.detect.split_spheres = !args.no_sphere_split;
+  options.detect.split_sphere_pieces = !args.no_sphere_pieces;
   if (args.no_bulge_test) options.detect.min_bulge_ratio = 0.0;
   if (args.no_curvature_test) options.detect.flat_curvature_ratio = 0.0;
   if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
@@ -121,6 +123,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   vision->add_flag("--no-sphere-split", args->no_sphere_split,
                    "separate touching balls without their centres (the detector before it, for "
                    "comparison)");
+  vision->add_flag("--no-sphere-pieces", args->no_sphere_pieces,
+                   "do not split a piece of the cut that no circle fits by the balls' centres "
+                   "(the detector before it, for comparison)");
   vision->add_flag("--no-bulge-test", args->no_bulge_test,
                    "keep round detections whose surface does not curve away (the detector "
                    "before the test, for comparison)");
