@@ -1050,6 +1050,37 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               ++st.rejected_size;
               continue;
             }
+            if (options.type_height_ratio > 0.0) {
+              // Kinds that fit by size but stand at clearly different heights: by the height.
+              std::vector<const TargetKind*> fitting;
+              double lowest = std::numeric_limits<double>::infinity(), highest = 0.0;
+              for (const TargetKind& k : kinds) {
+                if (k.radius_m <= 0.0 || k.centre_height_m <= 0.0) continue;
+                const double expected =
+                    focal * k.radius_m / (surface->depth_m + k.surface_to_centre_m);
+                if (std::max(d.radius_px / expected, expected / d.radius_px) >
+                    options.size_tolerance)
+                  continue;
+                fitting.push_back(&k);
+                lowest = std::min(lowest, 2.0 * k.centre_height_m);
+                highest = std::max(highest, 2.0 * k.centre_height_m);
+              }
+              // (Not with a semi-transparent kind among them: depth reads through it.)
+              const bool all_solid_fit = std::all_of(fitting.begin(), fitting.end(),
+                                                     [](const TargetKind* k) { return k->solid; });
+              if (fitting.size() > 1 && all_solid_fit &&
+                  highest >= options.type_height_ratio * lowest) {
+                const double height =
+                    StandingHeightM(piece_mask, roi.tl(), depth_mm, *setup.camera);
+                double nearest = std::numeric_limits<double>::infinity();
+                for (const TargetKind* k : fitting) {
+                  const double off = height > 0.0
+                                         ? std::abs(std::log(height / (2.0 * k->centre_height_m)))
+                                         : nearest;
+                  if (off < nearest) nearest = off, best = k;
+                }
+              }
+            }
             if (options.drop_too_tall && !piece_sized && !best->round) {
               // Taller than the kind can stand, on its edge (its width) or in the tallest
               // stack the season places: an upright bar or panel of its colour.

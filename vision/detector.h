@@ -52,6 +52,11 @@ struct DetectOptions {
   // edge, or its tallest stack) is not one (High Stakes' upright blue and red bars taken for
   // rings).
   bool drop_too_tall = true;
+  // With depth, when solid kinds of a colour whose heights differ by this factor or more both
+  // fit a piece by size, its kind is the one whose height its points span nearest (Starstruck's
+  // stars lying flat, 9 cm, against its 25 cm cubes: by size alone most were typed wrong).
+  // 0: by size alone.
+  double type_height_ratio = 1.5;
   double pile_area_ratio = 4.0;  // x the apparent area of one object
   SizeSplitOptions size_split;
   // With depth, blobs of a colour whose solid round kinds (spheres, triballs) are of one size

@@ -179,6 +179,29 @@ TEST(VisionEvalTest, BallsLeftTogetherByTheCutAreCountedByTheirCentres) {
   EXPECT_GE(r.found, r.found_without + 4);
 }
 
+// With depth, kinds that fit a piece by size but stand at different heights are told apart
+// by the height its points span (DetectOptions::type_height_ratio): Starstruck's stars lying
+// flat (9 cm) and its cubes (25 cm), of one colour and nearly one size. Measured with `slamo
+// eval vision --season starstruck --arena --frames 20 --seed 1`, `kmeans+defects`: typed
+// right, cubes 1 -> 10 of 11, stars 0 -> 25 of 27 (by size alone most stars were typed cubes).
+// The test asks for 0.8 of each with the rule, and that by size alone it was under 0.3.
+TEST(VisionEvalTest, StarsAndCubesAreTypedByTheirHeight) {
+  VisionEvalOptions without;
+  without.detect.type_height_ratio = 0.0;
+  const VisionMethodScore with_rule = Scores("starstruck", 20, 1, true).at(3);
+  const VisionMethodScore without_rule = Scores("starstruck", 20, 1, true, without).at(3);
+  ASSERT_EQ(with_rule.name, "kmeans+defects");
+  for (const char* type : {"cube", "star"}) {
+    SCOPED_TRACE(type);
+    const TypeScore& a = with_rule.types.at(type);
+    const TypeScore& b = without_rule.types.at(type);
+    ASSERT_GT(a.typed, 5);
+    ASSERT_GT(b.typed, 5);
+    EXPECT_GE(a.typed_right, 0.8 * a.typed);
+    EXPECT_LT(b.typed_right, 0.3 * b.typed);
+  }
+}
+
 // Nothing floats (DetectOptions::drop_floating): in the High Stakes arena the opponents'
 // bumpers, held 2 cm off the floor, were cut into ring-sized pieces; under them the camera sees
 // the floor behind the gap, so they are cleared, while rings, which stand on the floor or on
