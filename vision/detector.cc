@@ -730,7 +730,9 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           (box + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
       cv::Mat blob_mask(window.size(), CV_8UC1, cv::Scalar(0));
       FillOutline(blob, -window.tl(), &blob_mask);
-      bool blob_mask_is_fill = true;  // until a closing changes it
+      // The outline filled (after a split by size, eroded by a pixel, as it was measured
+      // with), until a closing changes it.
+      bool blob_mask_is_fill = true;
 
       // At its depth, how big should it be? Too small for every kind: noise (not eroded
       // away at a fixed size, which erased far balls in the thesis).
@@ -984,6 +986,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                   for (cv::Point& p : ball) p += bounds.tl() - window.tl();
                   separated.pieces.push_back(std::move(ball));
                 }
+                continue;  // split, not rejected
               }
             }
             ++st.rejected_shape;
@@ -1013,7 +1016,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                                cv::Rect(0, 0, bgr.cols, bgr.rows);
           cv::Mat piece_mask;
           if (whole && !piece_sized && blob_mask_is_fill && roi == window) {
-            piece_mask = blob_mask;  // the same contour filled in the same window: no redraw
+            piece_mask = blob_mask;  // the same contour in the same window: no redraw
           } else {
             piece_mask = cv::Mat(roi.size(), CV_8UC1, cv::Scalar(0));
             FillOutline(piece, -roi.tl(), &piece_mask);

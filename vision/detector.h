@@ -186,7 +186,8 @@ struct DetectStats {
   int rejected_size = 0;
   int rejected_flat = 0;      // round solid kinds whose surface does not curve (a bumper's face)
   int split_by_size = 0;      // blobs separated by the objects' known size
-  int split_spheres = 0;      // blobs separated by the centres of balls of one size
+  int split_spheres = 0;      // blobs (or pieces of the cut no circle fits) separated by the
+                              // centres of balls of one size
   int rejected_floating = 0;  // blobs with a part held off the floor over nothing (cleared)
   int rejected_attached = 0;  // pieces whose top runs on into a taller body (a bumper's chassis)
   int without_depth = 0;      // kept, but no range: no valid depth on them (or, without a depth

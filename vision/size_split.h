@@ -94,6 +94,9 @@ struct SizeSplitResult {
 
 // `mask`: CV_8UC1, non-zero on the blob; `depth_mm`: CV_16UC1 raw readings of the same size;
 // `offset`: where the mask's (0, 0) lies in the full image (for the camera's intrinsics).
+// When `depth_mm` is a view into a larger depth image, the rows under it are read too (a
+// hidden lower edge, SizeSplitOptions::hidden_fraction); a depth image of the mask's size
+// alone never shows one.
 SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
                             const CameraModel& camera, const ObjectExtent& extent,
                             const SizeSplitOptions& options = {});
