@@ -112,20 +112,20 @@ bool LowerEdgeHidden(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point off
 
 }  // namespace
 
+cv::Mat RimlessCore(const cv::Mat& mask, int erode_px, int min_pixels) {
+  if (erode_px <= 0) return mask;
+  cv::Mat core;
+  cv::erode(mask, core, cv::Mat(), cv::Point(-1, -1), erode_px);
+  return cv::countNonZero(core) < min_pixels ? mask : core;
+}
+
 SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Point offset,
                             const CameraModel& camera, const ObjectExtent& extent,
                             const SizeSplitOptions& options) {
   SizeSplitResult result;
   if (mask.empty() || extent.width_m <= 0.0 || extent.height_m <= 0.0) return result;
   // Points: the blob without its rim, where depth may read what lies behind the object.
-  // (A new matrix: eroded into `core` sharing `mask`'s pixels, the caller's blob shrank too.)
-  cv::Mat core;
-  if (options.erode_px > 0) {
-    cv::erode(mask, core, cv::Mat(), cv::Point(-1, -1), options.erode_px);
-    if (cv::countNonZero(core) < 16) core = mask;
-  } else {
-    core = mask;
-  }
+  const cv::Mat core = RimlessCore(mask, options.erode_px, 16);
   std::vector<cv::Point> pixels;
   std::vector<cv::Vec3f> points;  // robot frame, in units of the object's width and height
   for (int v = 0; v < core.rows; ++v) {

@@ -92,6 +92,12 @@ struct SizeSplitResult {
                     // then holds nothing)
 };
 
+// The blob without its outermost `erode_px` pixels (where depth may read what lies behind
+// the object), in a buffer of its own (eroded into a view of `mask`, the caller's blob would
+// shrink too); `mask` itself when erode_px is 0 or fewer than `min_pixels` would be left.
+// Shared with the split by the balls' centres (sphere_split.h).
+cv::Mat RimlessCore(const cv::Mat& mask, int erode_px, int min_pixels);
+
 // `mask`: CV_8UC1, non-zero on the blob; `depth_mm`: CV_16UC1 raw readings of the same size;
 // `offset`: where the mask's (0, 0) lies in the full image (for the camera's intrinsics).
 // When `depth_mm` is a view into a larger depth image, the rows under it are read too (a

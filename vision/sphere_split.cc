@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vision/contour_trace.h"
+#include "vision/size_split.h"
 
 namespace slamo::vision {
 
@@ -47,14 +48,7 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
     }
     if (seen >= 32 && low < (options.min_explained - 0.2) * seen) return result;
   }
-  // Its own buffer: eroded into one shared with `mask`, the caller's blob would shrink.
-  cv::Mat core;
-  if (options.erode_px > 0) {
-    cv::erode(mask, core, cv::Mat(), cv::Point(-1, -1), options.erode_px);
-    if (cv::countNonZero(core) < options.min_points) core = mask;
-  } else {
-    core = mask;
-  }
+  const cv::Mat core = RimlessCore(mask, options.erode_px, options.min_points);
   // The blob's points in the robot frame (z up from the floor), where a ball can be: from the
   // floor to its top, with the tolerance either side.
   std::vector<cv::Point> pixels;
