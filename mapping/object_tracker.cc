@@ -14,7 +14,7 @@ ObjectTracker::ObjectTracker(const ObjectTrackerOptions& options) : options_(opt
 
 void ObjectTracker::Update(const Eigen::Vector3d& pose, const Eigen::Matrix3d& pose_covariance,
                            const std::vector<ObjectObservation>& observations, double t_s,
-                           const std::function<bool(const Eigen::Vector2d&)>& expected_visible) {
+                           const std::function<bool(const TrackedObject&)>& expected_visible) {
   // Objects drift only if the options say so (pushed objects are handled by re-detection).
   for (TrackedObject& o : objects_) {
     const double dt = std::max(0.0, t_s - o.last_seen_s);
@@ -67,7 +67,7 @@ void ObjectTracker::Update(const Eigen::Vector3d& pose, const Eigen::Matrix3d& p
   // Expected but not seen: robots move objects; lose confidence, and forget at the floor.
   if (expected_visible) {
     for (size_t i = 0; i < objects_.size(); ++i) {
-      if (!seen[i] && expected_visible(objects_[i].position_m)) {
+      if (!seen[i] && expected_visible(objects_[i])) {
         objects_[i].confidence -= options_.missed_confidence_loss;
       }
     }

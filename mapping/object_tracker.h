@@ -49,12 +49,12 @@ class ObjectTracker {
   explicit ObjectTracker(const ObjectTrackerOptions& options = {});
 
   // One frame's observations from the robot at `pose` (with `pose_covariance`), at time t_s.
-  // `expected_visible` says whether a field point should be visible in this frame (in the
-  // camera's view and range); tracked objects for which it is true and that were not seen
-  // lose confidence.
+  // `expected_visible` says whether a tracked object should be visible in this frame (whole
+  // in the camera's view, and in range); tracked objects for which it is true and that were
+  // not seen lose confidence.
   void Update(const Eigen::Vector3d& pose, const Eigen::Matrix3d& pose_covariance,
               const std::vector<ObjectObservation>& observations, double t_s,
-              const std::function<bool(const Eigen::Vector2d&)>& expected_visible = {});
+              const std::function<bool(const TrackedObject&)>& expected_visible = {});
 
   const std::vector<TrackedObject>& objects() const { return objects_; }
   // Forgets the objects for which `gone` is true (e.g. believed where the robot now stands);

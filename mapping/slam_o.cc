@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "platform/camera_geometry.h"
 #include "platform/field_geometry.h"
 
 namespace slamo::mapping {
@@ -181,12 +182,22 @@ ObjectFrame SlamO::TrackObjects(const platform::RgbdFrame& frame, double t_s) {
   // Placed through the best pose estimate (and its covariance); objects in view and range but
   // not seen lose confidence.
   const double half_fov = std::atan(camera_.width_px / 2.0 / camera_.fx) - options_.fov_margin_rad;
-  tracker_.Update(pose, ekf_.pose_covariance(), seen, t_s, [&](const Eigen::Vector2d& p) {
-    const Eigen::Vector2d z = EkfSlam::Observe(pose, p);
+  tracker_.Update(pose, ekf_.pose_covariance(), seen, t_s, [&](const TrackedObject& o) {
+    const Eigen::Vector2d z = EkfSlam::Observe(pose, o.position_m);
     return z.x() > options_.object_min_range_m && z.x() < options_.object_max_range_m &&
-           std::abs(z.y()) < half_fov;
+           std::abs(z.y()) < half_fov && WholeInView(pose, o);
   });
   return out;
+}
+
+bool SlamO::WholeInView(const Eigen::Vector3d& pose, const TrackedObject& object) const {
+  const field::ObjectType* type = season_.FindObjectType(object.kind);
+  if (!type) return true;
+  const Eigen::Vector2d rel = object.position_m - pose.head<2>();
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  return platform::WholeInView(
+      camera_, Eigen::Vector2d(c * rel.x() + s * rel.y(), -s * rel.x() + c * rel.y()), type->size_m,
+      type->height_m, options_.fov_margin_rad);
 }
 
 std::vector<TrackedObject> SlamO::ConfirmedObjects(const std::vector<int>& taken_ids) const {

@@ -53,9 +53,10 @@ struct SlamOOptions {
   // Drop object detections the field's geometry rules out (outside the perimeter, above
   // where objects can be), seen from the pose estimate with its uncertainty.
   bool field_gate = true;
-  // Objects are tracked, and expected to be seen, within this range and the camera's field of
-  // view less fov_margin_rad.
-  double object_min_range_m = 0.8;
+  // Objects are expected to be seen (and lose confidence when they are not) within this range
+  // and the camera's field of view less fov_margin_rad, whole: from the camera's mount and the
+  // season's object sizes (SlamO::WholeInView; near objects leave the view below).
+  double object_min_range_m = 0.0;
   double object_max_range_m = 3.5;
   double fov_margin_rad = 0.05;
 };
@@ -150,6 +151,10 @@ class SlamO {
   int ForgetObjectsUnderRobot(double length_m, double width_m,
                               const std::optional<Eigen::Vector3d>& from = std::nullopt,
                               double mouth_m = 0.0);
+
+  // Whether an object at its tracked position would be seen whole by the camera from `pose`
+  // (an upright box of its kind's size and height on the floor).
+  bool WholeInView(const Eigen::Vector3d& pose, const TrackedObject& object) const;
 
   // What it believes.
   const EkfSlam& ekf() const { return ekf_; }

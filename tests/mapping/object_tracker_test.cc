@@ -68,7 +68,9 @@ TEST(ObjectTrackerTest, MissingObjectsFadeAndGo) {
   ObjectTracker tracker;
   const Eigen::Vector3d pose(0, 0, 0);
   const Eigen::Matrix3d pose_cov = Eigen::Matrix3d::Identity() * 1e-6;
-  const auto in_view = [](const Eigen::Vector2d& p) { return p.x() > 0.5 && p.x() < 4.0; };
+  const auto in_view = [](const TrackedObject& o) {
+    return o.position_m.x() > 0.5 && o.position_m.x() < 4.0;
+  };
   for (int frame = 0; frame < 3; ++frame)
     tracker.Update(pose, pose_cov, {See(pose, {1.5, 0.4}, &rng)}, frame, in_view);
   ASSERT_EQ(tracker.objects().size(), 1u);
@@ -83,7 +85,7 @@ TEST(ObjectTrackerTest, MissingObjectsFadeAndGo) {
   ObjectTracker behind;
   behind.Update(pose, pose_cov, {See(pose, {1.5, 0.4}, &rng)}, 0.0, in_view);
   for (int frame = 1; frame < 10; ++frame)
-    behind.Update(pose, pose_cov, {}, frame, [](const Eigen::Vector2d&) { return false; });
+    behind.Update(pose, pose_cov, {}, frame, [](const TrackedObject&) { return false; });
   EXPECT_EQ(behind.objects().size(), 1u);
 }
 

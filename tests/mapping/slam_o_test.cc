@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "field_configs/loader.h"
+#include "platform/camera_geometry.h"
 #include "platform/sim/sim_renderer.h"
 #include "platform/sim/sim_world.h"
 
@@ -161,6 +162,16 @@ TEST_F(SlamOTest, ObjectsSeenTwiceAreMappedWhereTheyAre) {
   EXPECT_EQ(slam.ConfirmedObjects({taken}).size(), confirmed.size() - 1);
 }
 
+// A start known exactly, over the surveyed markers as `renderer` draws them.
+SlamOPrior KnownStart(const platform::SimRenderer& renderer, const platform::Pose2D& start) {
+  SlamOPrior prior;
+  prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
+  prior.covariance = Eigen::Matrix3d::Identity() * 1e-6;
+  for (const Eigen::Vector3d& c : renderer.landmark_centres())
+    prior.surveyed_markers.push_back(c.head<2>());
+  return prior;
+}
+
 // Push Back's blocks lie in touching groups (three red ones in an L in front of the red
 // start). The match detector separates blobs of a colour with no round kind by the blocks' known
 // size: without it the group is one blob three blocks wide, rejected by size, and the planner
@@ -173,11 +184,7 @@ TEST(SlamOBlocksTest, ATouchingGroupOfBlocksIsTrackedBlockByBlock) {
   const platform::Pose2D start{-1.45, 0.6, 0.0};  // 0.85 m behind the group, facing it
   SlamOOptions options;
   options.ekf.add_landmarks = false;
-  SlamOPrior prior;
-  prior.pose = Eigen::Vector3d(start.x_m, start.y_m, start.theta_rad);
-  prior.covariance = Eigen::Matrix3d::Identity() * 1e-6;
-  for (const Eigen::Vector3d& c : renderer.landmark_centres())
-    prior.surveyed_markers.push_back(c.head<2>());
+  const SlamOPrior prior = KnownStart(renderer, start);
   SlamO slam(season, robot.camera, prior, options);
   for (int k = 0; k < 3; ++k)
     slam.TrackObjects(renderer.Render(world, start, k / 30.0, nullptr), k / 30.0);
@@ -198,6 +205,76 @@ TEST(SlamOBlocksTest, ATouchingGroupOfBlocksIsTrackedBlockByBlock) {
   }
   for (size_t k = 0; k < group.size(); ++k)
     EXPECT_TRUE(found[k]) << "block at " << group[k].transpose() << " not tracked";
+}
+
+// An object the camera should see whole and does not is not where it was believed: it loses
+// confidence. Near the robot the camera, looking down, loses an object below its view: that
+// one is kept. Which is which comes from the camera's mount and the object's size
+// (platform::WholeInView), not a fixed range: the V5 robot's camera sees a Push Back block
+// whole from 0.64 m.
+TEST(SlamOBlocksTest, ANearObjectTakenAwayFadesOnlyWhereTheCameraSeesIt) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  platform::SimWorld world = platform::CreateWorld(season, 3);
+  platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 3);
+  const platform::Pose2D start{-1.45, 0.6, 0.0};  // 0.85 m behind a group of three blocks
+  SlamOOptions options;
+  options.ekf.add_landmarks = false;
+  const SlamOPrior prior = KnownStart(renderer, start);
+  const field::ObjectType* block = season.FindObjectType("block");
+  ASSERT_NE(block, nullptr);
+  // The nearest red block of the group is taken off the field once it is mapped; the robot
+  // then drives to face where it was from `back_m` behind it and looks (two frames).
+  // Returns its confidence before and after.
+  const auto look_from = [&](double back_m) {
+    SlamO slam(season, robot.camera, prior, options);
+    platform::SimWorld field = world;
+    for (int k = 0; k < 3; ++k)
+      slam.TrackObjects(renderer.Render(field, start, k / 30.0, nullptr), k / 30.0);
+    const Eigen::Vector2d from(start.x_m, start.y_m);
+    auto nearest = field.objects.end();
+    for (auto it = field.objects.begin(); it != field.objects.end(); ++it) {
+      const Eigen::Vector2d rel = it->center_m.head<2>() - from;
+      if (it->colour != "red" || it->center_m.z() > 0.1 || rel.x() < 0.5) continue;
+      if (nearest == field.objects.end() ||
+          rel.norm() < (nearest->center_m.head<2>() - from).norm())
+        nearest = it;
+    }
+    std::pair<double, double> confidence(-1.0, -1.0);
+    if (nearest == field.objects.end()) return confidence;
+    const Eigen::Vector2d at = nearest->center_m.head<2>();
+    field.objects.erase(nearest);
+    int id = -1;
+    for (const TrackedObject& o : slam.ConfirmedObjects()) {
+      if (o.colour == "red" && (o.position_m - at).norm() < 0.05)
+        id = o.id, confidence.first = o.confidence;
+    }
+    const Eigen::Vector2d dir = (at - from).normalized();
+    const Eigen::Vector2d stand = at - back_m * dir;
+    const platform::Pose2D pose{stand.x(), stand.y(), std::atan2(dir.y(), dir.x())};
+    slam.Predict(OdometryIncrement(start, pose));
+    for (int k = 0; k < 2; ++k)
+      slam.TrackObjects(renderer.Render(field, pose, 1.0 + k / 30.0, nullptr), 1.0 + k / 30.0);
+    for (const TrackedObject& o : slam.ConfirmedObjects())
+      if (o.id == id) confidence.second = o.confidence;
+    return confidence;
+  };
+  // 0.7 m from the robot's centre: in view, and not seen in either frame.
+  const auto [seen_before, seen_after] = look_from(0.7);
+  ASSERT_GT(seen_before, 0.0) << "the block was not mapped";
+  EXPECT_LT(seen_after, seen_before - 0.4);
+  // 0.45 m: below the view, kept. (With the fixed 0.8 m range SLAM-O had, both were kept.)
+  const auto [below_before, below_after] = look_from(0.45);
+  ASSERT_GT(below_before, 0.0);
+  EXPECT_DOUBLE_EQ(below_after, below_before);
+  // The distance comes from the mount: the block's near bottom edge on the lowest ray of the
+  // view less the margin (0.64 m for this camera, 0.38 m high, pitched 15 degrees).
+  const field::CameraConfig& camera = robot.camera;
+  const double lowest =
+      camera.mount.pitch_deg * kPi / 180.0 + std::atan(camera.cy / camera.fy) - 0.05;
+  EXPECT_NEAR(platform::NearestWholeInView(camera, block->size_m, block->height_m, 0.05, 2.0),
+              camera.mount.x_m + camera.mount.height_m / std::tan(lowest) + block->size_m / 2.0,
+              0.015);
 }
 
 // An object believed where the robot stands cannot be there: it is forgotten, unless it lies
