@@ -233,6 +233,10 @@ void SlamO::UpdateMaps(const std::vector<int>& taken_ids,
   if (obstacles) obstacle_map_.SetObjects(blocking);
 }
 
+bool SlamO::ForgetObject(int id) {
+  return tracker_.Forget([id](const TrackedObject& o) { return o.id == id; }) > 0;
+}
+
 int SlamO::ForgetObjectsUnderRobot(double length_m, double width_m,
                                    const std::optional<Eigen::Vector3d>& from, double mouth_m) {
   const Eigen::Vector3d pose = ekf_.pose();

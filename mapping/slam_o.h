@@ -163,6 +163,9 @@ class SlamO {
   const ObjectTracker& tracker() const { return tracker_; }
   // Confirmed objects (seen often enough), less `taken_ids`, in the tracker's order.
   std::vector<TrackedObject> ConfirmedObjects(const std::vector<int>& taken_ids = {}) const;
+  // Forgets one tracked object (e.g. a pick's target not seen where it should have been);
+  // whether it was tracked.
+  bool ForgetObject(int id);
   const ObjectMap& object_map() const { return object_map_; }
   const ObjectMap& obstacle_map() const { return obstacle_map_; }
   const FrameSelector& frame_selector() const { return selector_; }

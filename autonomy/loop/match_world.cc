@@ -614,6 +614,9 @@ bool MatchWorld::Pick(const strategy::Action& action) {
     if (approached && room) {
       slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m, std::nullopt,
                                     robot_.intake.reach_m);
+      // The target itself, whatever the errors' margin above: the intake was aimed at it and
+      // found nothing (if it lies near, a look maps it again).
+      if (action.object_id >= 0) slam_.ForgetObject(action.object_id);
     }
     UpdateMaps();
     return false;
