@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "field_configs/summary.h"
+#include "platform/camera_geometry.h"
 #include "platform/field_geometry.h"
 
 namespace slamo::strategy {
@@ -209,8 +210,31 @@ class Base : public Strategy {
 
   // Seconds for the final straight approach of margin_m and the settling around it.
   double ApproachSeconds(const StrategyContext& c) const {
-    return options_.approach_margin_m / c.robot->drive.cruise_speed_mps + 0.5;
+    return ApproachSeconds(c, options_.approach_margin_m);
   }
+  static double ApproachSeconds(const StrategyContext& c, double margin_m) {
+    return margin_m / c.robot->drive.cruise_speed_mps + 0.5;
+  }
+  // A pick's staging margin: approach_margin_m, or (StrategyOptions::pick_in_view) further out
+  // where the camera sees the object whole, so that the look on arrival checks it is still
+  // there (a camera that looks down loses near objects below its view).
+  double PickMargin(const StrategyContext& c, const std::string& kind) const {
+    const field::ObjectType* type = c.season->FindObjectType(kind);
+    if (!options_.pick_in_view || !perceives() || !type) return options_.approach_margin_m;
+    auto it = pick_margins_.find(kind);
+    if (it == pick_margins_.end()) {
+      const double r = type->size_m / 2.0;
+      const double in_view =
+          platform::NearestWholeInView(c.robot->camera, type->size_m, type->height_m,
+                                       options_.view_margin_rad, PickDistance(*c.robot, r) + 1.0);
+      it = pick_margins_
+               .emplace(kind,
+                        std::max(options_.approach_margin_m, in_view - PickDistance(*c.robot, r)))
+               .first;
+    }
+    return it->second;
+  }
+  mutable std::map<std::string, double> pick_margins_;  // PickMargin per kind (one robot)
 
   // Position variance (worst axis) after n more frames, by the iterated-frame model.
   double PoseVarianceAfter(const Belief& b, int frames) const {
@@ -334,7 +358,11 @@ class Base : public Strategy {
   // short, its wheels slipping, and the intake takes nothing (Push Back's blocks beside a long
   // goal's end); from another side the approach may be free.
   bool ApproachIsFree(const StrategyContext& c, const Eigen::Vector3d& stage) const {
-    const double to_go_m = options_.approach_margin_m - c.robot->intake.reach_m / 2.0;
+    return ApproachIsFree(c, stage, options_.approach_margin_m);
+  }
+  bool ApproachIsFree(const StrategyContext& c, const Eigen::Vector3d& stage,
+                      double margin_m) const {
+    const double to_go_m = margin_m - c.robot->intake.reach_m / 2.0;
     const Eigen::Vector2d dir(std::cos(stage.z()), std::sin(stage.z()));
     const Eigen::Vector2d mid = stage.head<2>() + 0.5 * to_go_m * dir;
     return platform::FootprintIsFree(*c.season, platform::Pose2D{mid.x(), mid.y(), stage.z()},
@@ -700,12 +728,12 @@ class Base : public Strategy {
     const auto same = [&](const ObjectBelief& x) {
       return x.kind == o.kind && x.colour == o.colour && Scores(c, x);
     };
-    const double corridor =
-        options_.approach_margin_m + c.robot->intake.reach_m / 2.0 + kCorridorSlack_m;
-    std::optional<Eigen::Vector3d> stage = PickStage(
-        c, o.position_m, r, from.head<2>(), options_.approach_margin_m,
-        [&](const Eigen::Vector3d& s) {
-          return ApproachIsFree(c, s) && CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
+    const double margin = PickMargin(c, o.kind);
+    const double corridor = margin + c.robot->intake.reach_m / 2.0 + kCorridorSlack_m;
+    std::optional<Eigen::Vector3d> stage =
+        PickStage(c, o.position_m, r, from.head<2>(), margin, [&](const Eigen::Vector3d& s) {
+          return ApproachIsFree(c, s, margin) &&
+                 CorridorFree(b, c, s, corridor, o.id, 0.0, nullptr, same);
         });
     if (!stage) return out;
     const Eigen::Vector2d dir(std::cos(stage->z()), std::sin(stage->z()));
@@ -723,18 +751,17 @@ class Base : public Strategy {
     if (target != &o) {
       // The stage moves back along the same heading to the one nearest the bumper, whose
       // corridor must be free in turn.
-      const Eigen::Vector2d at =
-          t_o.position_m - (PickDistance(*c.robot, r) + options_.approach_margin_m) * dir;
+      const Eigen::Vector2d at = t_o.position_m - (PickDistance(*c.robot, r) + margin) * dir;
       stage = Eigen::Vector3d(at.x(), at.y(), stage->z());
-      if (!c.is_clear(at) || !ApproachIsFree(c, *stage) ||
+      if (!c.is_clear(at) || !ApproachIsFree(c, *stage, margin) ||
           !CorridorFree(b, c, *stage, corridor, t_o.id, 0.0, nullptr, same))
         return out;
     }
     if (failed_targets_.count(Key(*stage))) return out;
     const std::optional<double> t = StageTravel(b, c, from, *stage, &t_o, false, -1);
     if (!t) return out;
-    const double pick_s =
-        *t * Scale(kDrive) + (ApproachSeconds(c) + c.robot->intake.pick_s) * Scale(kPickClass);
+    const double pick_s = *t * Scale(kDrive) +
+                          (ApproachSeconds(c, margin) + c.robot->intake.pick_s) * Scale(kPickClass);
     const double before = FloorPoints(*c.season, t_o.position_m, t_o.kind, t_o.colour, c.alliance);
     const Eigen::Vector3d picked_at(t_o.position_m.x() - dir.x() * PickDistance(*c.robot, r),
                                     t_o.position_m.y() - dir.y() * PickDistance(*c.robot, r),
@@ -828,7 +855,7 @@ class Base : public Strategy {
       a.target =
           Eigen::Vector3d(cycle.object->position_m.x(), cycle.object->position_m.y(), stage.z());
       a.frames = 0;
-      a.expected_s = ApproachSeconds(c) + c.robot->intake.pick_s;
+      a.expected_s = ApproachSeconds(c, PickMargin(c, cycle.object->kind)) + c.robot->intake.pick_s;
       a.why =
           cycle.object->colour + " " + cycle.object->kind + " #" + std::to_string(cycle.object->id);
     } else {

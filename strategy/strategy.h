@@ -105,8 +105,15 @@ struct Action {
 struct StrategyOptions {
   int horizon = 2;                  // pick-and-score cycles searched ahead
   double approach_margin_m = 0.15;  // staging pose this far before the final straight approach
-  double push_run_in_m = 0.35;      // knock: straight run-in to the object on a raised structure
-  double pick_tolerance_m = 0.12;   // lateral error the intake forgives
+  // A strategy that perceives stages a pick further out, where the camera sees the target
+  // whole (at least approach_margin_m), and the executive gives the pick up when the look on
+  // arrival does not find it (pushed away, or never there). The view's edges less
+  // view_margin_rad (as SlamOOptions::fov_margin_rad). Off: it made more picks take their
+  // target but scored less (the longer approach costs time; README "Looking before a pick").
+  bool pick_in_view = false;
+  double view_margin_rad = 0.05;
+  double push_run_in_m = 0.35;     // knock: straight run-in to the object on a raised structure
+  double pick_tolerance_m = 0.12;  // lateral error the intake forgives
   std::vector<int> frame_choices = {0, 5, 10, 20};
   // Planner: a look before a cycle is charged its seconds at the best rate (points per
   // second) of the sequences that start without one, times this: the time it takes is lost

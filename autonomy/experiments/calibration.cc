@@ -60,7 +60,8 @@ std::vector<AttemptSample> SamplesOf(const std::vector<MatchOutcome>& outcomes) 
   for (const MatchOutcome& o : outcomes) {
     if (o.failed) continue;
     for (const AttemptCheck& a : o.records) {
-      if (a.outcome.empty()) continue;  // not judged (no truth)
+      if (a.outcome.empty()) continue;       // not judged (no truth)
+      if (a.outcome == "skipped") continue;  // given up before the approach: no attempt
       AttemptSample s;
       s.action = a.action;
       s.kind = a.kind;

@@ -69,6 +69,9 @@ const std::map<std::string, std::string>& TunableParams() {
       {"look_frames", "frames of an exploratory look"},
       {"pick_tolerance", "lateral error the intake forgives, m"},
       {"approach_margin", "staging distance before the final approach, m"},
+      {"pick_in_view",
+       "1: stage picks where the camera sees the target whole and skip it when the look misses it; "
+       "0: approach_margin only"},
       {"check_spacing", "m of path between quick looks while driving (0: none)"},
       {"correction_frames", "frames of a quick look"},
       {"arrival_fixes", "look-and-correct rounds on arrival"},
@@ -118,6 +121,8 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->strategy_options.look_frames = ToInt(name, value);
   } else if (name == "pick_tolerance") {
     setup->strategy_options.pick_tolerance_m = ToDouble(name, value);
+  } else if (name == "pick_in_view") {
+    setup->strategy_options.pick_in_view = ToInt(name, value) != 0;
   } else if (name == "approach_margin") {
     setup->strategy_options.approach_margin_m = ToDouble(name, value);
   } else if (name == "check_spacing") {
@@ -377,7 +382,9 @@ std::vector<ComboSummary> Summarise(const std::vector<MatchOutcome>& outcomes) {
       updates += o->nees_updates, honest += o->nees_honest;
       attempts += o->attempts, inside += o->attempts_inside;
       for (const AttemptCheck& a : o->records) {
-        if (a.action == "PICK") {
+        if (a.action == "PICK" && a.outcome == "skipped") {
+          ++s.pick_skips;
+        } else if (a.action == "PICK") {
           ++s.picks;
           pick_target += a.outcome == "target";
           pick_other += a.outcome == "other";
@@ -431,7 +438,8 @@ std::string SummaryCsv(const std::vector<ComboSummary>& rows) {
   out << "rank,combo,matches,failed,mean_points,ci95_points,mean_gained,ci95_gained,overruns,mean_"
          "overrun_s,"
          "mean_ate_m,nees_honest_fraction,attempts_inside_fraction,picks,pick_target_fraction,"
-         "pick_other_fraction,pick_nothing_fraction,releases,release_scored_fraction,knocks,"
+         "pick_other_fraction,pick_nothing_fraction,pick_skips,releases,release_scored_fraction,"
+         "knocks,"
          "knock_scored_fraction,mean_wall_s\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
@@ -440,8 +448,8 @@ std::string SummaryCsv(const std::vector<ComboSummary>& rows) {
         << ',' << r.overruns << ',' << r.mean_overrun_s << ',' << r.mean_ate_m << ','
         << r.nees_honest_fraction << ',' << r.attempts_inside_fraction << ',' << r.picks << ','
         << r.pick_target_fraction << ',' << r.pick_other_fraction << ',' << r.pick_nothing_fraction
-        << ',' << r.releases << ',' << r.release_scored_fraction << ',' << r.knocks << ','
-        << r.knock_scored_fraction << ',' << r.mean_wall_s << '\n';
+        << ',' << r.pick_skips << ',' << r.releases << ',' << r.release_scored_fraction << ','
+        << r.knocks << ',' << r.knock_scored_fraction << ',' << r.mean_wall_s << '\n';
   }
   return out.str();
 }
@@ -467,6 +475,7 @@ nlohmann::json SummaryJson(const std::vector<ComboSummary>& rows,
                             {"pick_target_fraction", r.pick_target_fraction},
                             {"pick_other_fraction", r.pick_other_fraction},
                             {"pick_nothing_fraction", r.pick_nothing_fraction},
+                            {"pick_skips", r.pick_skips},
                             {"knocks", r.knocks},
                             {"knock_scored_fraction", r.knock_scored_fraction},
                             {"releases", r.releases},
@@ -484,8 +493,8 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
       << "gained (95% CI)" << std::setw(10) << "overruns" << std::setw(10) << "ATE m"
       << std::setw(10) << "NEES ok" << std::setw(10) << "in 3sig" << std::setw(7) << "picks"
       << std::setw(8) << "target" << std::setw(8) << "other" << std::setw(8) << "nothing"
-      << std::setw(7) << "rels" << std::setw(8) << "scored" << std::setw(8) << "knocks"
-      << std::setw(8) << "down" << std::setw(10) << "wall s"
+      << std::setw(7) << "skips" << std::setw(7) << "rels" << std::setw(8) << "scored"
+      << std::setw(8) << "knocks" << std::setw(8) << "down" << std::setw(10) << "wall s"
       << "\n";
   int rank = 0;
   for (const ComboSummary& r : rows) {
@@ -499,8 +508,9 @@ void PrintSummaryTable(const std::vector<ComboSummary>& rows, std::ostream& out)
         << r.nees_honest_fraction << std::setw(10) << r.attempts_inside_fraction << std::setw(7)
         << r.picks << std::setprecision(2) << std::setw(8) << r.pick_target_fraction << std::setw(8)
         << r.pick_other_fraction << std::setw(8) << r.pick_nothing_fraction << std::setw(7)
-        << r.releases << std::setw(8) << r.release_scored_fraction << std::setw(8) << r.knocks
-        << std::setw(8) << r.knock_scored_fraction << std::setw(10) << r.mean_wall_s << "\n";
+        << r.pick_skips << std::setw(7) << r.releases << std::setw(8) << r.release_scored_fraction
+        << std::setw(8) << r.knocks << std::setw(8) << r.knock_scored_fraction << std::setw(10)
+        << r.mean_wall_s << "\n";
     if (r.failed) out << "     (" << r.failed << " matches failed: see tune.json)\n";
   }
 }

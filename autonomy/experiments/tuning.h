@@ -82,8 +82,9 @@ struct ComboSummary {
   double nees_honest_fraction = 0.0;      // over all updates: NEES in its band or below
   double attempts_inside_fraction = 0.0;  // over all picks/scores: error inside 3-sigma
   // Picks that took their target, another object, nothing; releases that scored in the goal
-  // aimed at (fractions of the attempts; NaN: none).
-  int picks = 0, releases = 0;
+  // aimed at (fractions of the attempts; NaN: none). Picks given up before the approach
+  // (the look on arrival did not find the target) are not attempts: counted apart.
+  int picks = 0, releases = 0, pick_skips = 0;
   double pick_target_fraction = 0.0, pick_other_fraction = 0.0, pick_nothing_fraction = 0.0;
   double release_scored_fraction = 0.0;
   // Knocks off a raised structure, and the fraction that brought the object down into the

@@ -155,7 +155,7 @@ std::vector<ObjectReport> ScoreObjects(const MatchWorld& world) {
 }  // namespace
 
 const std::vector<std::string>& PickOutcomes() {
-  static const std::vector<std::string> names = {"target", "other", "nothing"};
+  static const std::vector<std::string> names = {"target", "other", "nothing", "skipped"};
   return names;
 }
 const std::vector<std::string>& ScoreOutcomes() {
@@ -300,6 +300,9 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
       const std::optional<std::vector<TrueObject>> objects_after = world.io().TrueObjects();
       if (objects_before && objects_after)
         JudgeAttempt(world.field(), *objects_before, *objects_after, &*attempt);
+      // Given up before the approach (the look on arrival did not find the target): no pick
+      // was tried, whatever the simulator's objects say.
+      if (action.kind == ActionKind::kPick && world.pick_skipped()) attempt->outcome = "skipped";
       result.attempts.push_back(*attempt);
     }
     entry.ok = ok;

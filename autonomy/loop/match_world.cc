@@ -343,6 +343,7 @@ int MatchWorld::Observe(int max_frames) {
   rule.gmm_max_frames = std::min(rule.gmm_max_frames, max_frames);
   rule.gmm_min_frames = std::min(rule.gmm_min_frames, max_frames);
   slam_.BeginStop(rule);
+  if (frames_at_rest_ == 0) look_start_s_ = now_s();
   platform::RgbdFrame rgbd;
   int taken = 0;
   bool last_tracked = false;
@@ -584,8 +585,30 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   const strategy::Belief before = Belief();
   strategy::ObjectBelief target;
   target.position_m = action.target.head<2>();
+  bool believed = false;
+  pick_skipped_ = false;
   for (const strategy::ObjectBelief& o : before.objects) {
-    if (o.id == action.object_id) target = o;
+    if (o.id == action.object_id) target = o, believed = true;
+  }
+  // The look on arrival, from where the camera sees the target whole
+  // (StrategyOptions::pick_in_view): not seen in it, it is not there (pushed away, or never
+  // was): no approach. Lost from the map since the strategy chose it: the same.
+  if (perceive_ && setup_.strategy_options.pick_in_view && action.object_id >= 0) {
+    bool gone = !believed;
+    if (believed && frames_at_rest_ > 0) {
+      for (const mapping::TrackedObject& o : slam_.ConfirmedObjects(picked_ids_)) {
+        if (o.id != action.object_id || o.last_seen_s >= look_start_s_) continue;
+        if (slam_.WholeInView(slam_.pose(), o)) {
+          slam_.ForgetObject(o.id);
+          UpdateMaps();
+          gone = true;
+        }
+      }
+    }
+    if (gone) {
+      pick_skipped_ = true;
+      return false;
+    }
   }
   if (perceive_ && frames_at_rest_ == 0) {
     Observe(std::max(action.frames, setup_.correction_frames));

@@ -176,6 +176,9 @@ class MatchWorld {
   // took an object of the target's kind and colour (another one is held, but the pick
   // failed).
   bool Pick(const strategy::Action& action);
+  // Whether the last Pick gave up before its approach: the look on arrival did not find the
+  // target (StrategyOptions::pick_in_view).
+  bool pick_skipped() const { return pick_skipped_; }
   // Final approach to the goal and the release; true when the object landed where intended.
   bool Score(const strategy::Action& action);
   // Turns to action.target's heading and releases the held object there, on the floor;
@@ -238,6 +241,8 @@ class MatchWorld {
   // Frames taken since the robot last moved: a pick or score right after a look at the same
   // standstill does not look again (the same view, and the same per-stop bias counted twice).
   int frames_at_rest_ = 0;
+  double look_start_s_ = -1.0;  // when the first look since the robot last moved began
+  bool pick_skipped_ = false;
   std::vector<PoseSample> samples_;
   std::vector<Snapshot> snapshots_;
   std::shared_ptr<const CameraView> camera_view_;  // the last frame seen, for the snapshots

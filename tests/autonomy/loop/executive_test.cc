@@ -561,17 +561,18 @@ TEST(Executive, AnArrivalErrorTheNextActionAbsorbsIsNotDrivenOff) {
 // again (PICK x, PICK x, 2 s lost); the target of a pick that found nothing is forgotten.
 // (200 seeds disturbed: picks 219 -> 208, took their target 0.69 -> 0.73, points 5.10 -> 5.08;
 // nominal and Over Under unchanged.)
-MatchResult PushBackDisturbedSeed2() {
+MatchResult PushBackDisturbedSeed2(bool pick_in_view) {
   const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
   MatchSetup setup;
   setup.strategy = "planner";
   setup.scenario = Scenario::kDisturbed;
+  setup.strategy_options.pick_in_view = pick_in_view;
   return RunMatch(season, robot, setup, 2);
 }
 
 TEST(Executive, APickThatFoundNothingIsNotTriedOnTheSameTargetAgain) {
-  const MatchResult r = PushBackDisturbedSeed2();
+  const MatchResult r = PushBackDisturbedSeed2(false);
   EXPECT_EQ(r.overrun_s, 0.0);
   std::vector<Eigen::Vector2d> empty;
   for (const AttemptCheck& a : r.attempts) {
@@ -580,6 +581,27 @@ TEST(Executive, APickThatFoundNothingIsNotTriedOnTheSameTargetAgain) {
     empty.push_back(a.aim_m);
   }
   EXPECT_FALSE(empty.empty());  // the pushed block's spot, tried once
+}
+
+// The same match with StrategyOptions::pick_in_view: the pick is staged where the camera sees
+// the block's spot whole, the look on arrival does not find it, and the pick is given up
+// before its approach (no time spent, judged "skipped", not an attempt that took nothing).
+TEST(Executive, WithPickInViewAPickWhoseTargetIsGoneIsSkipped) {
+  const MatchResult r = PushBackDisturbedSeed2(true);
+  EXPECT_EQ(r.overrun_s, 0.0);
+  int skipped = 0;
+  for (const AttemptCheck& a : r.attempts) {
+    if (a.action != "PICK") continue;
+    EXPECT_NE(a.outcome, "nothing") << a.t_s;
+    if (a.outcome != "skipped") continue;
+    ++skipped;
+    EXPECT_GT(a.target_error_m, 0.2);  // nothing of its kind where it was believed
+  }
+  EXPECT_GE(skipped, 1);
+  int given_up = 0;  // PICK entries that failed without moving
+  for (const TimelineEntry& e : r.timeline)
+    given_up += e.action == "PICK" && !e.ok && e.end_s - e.t_s < 0.05;
+  EXPECT_EQ(given_up, skipped);
 }
 
 // A look before a cycle is charged the time it takes at the best rate of the sequences without
