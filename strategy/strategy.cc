@@ -217,7 +217,8 @@ class Base : public Strategy {
   }
   // A pick's staging margin: approach_margin_m, or (StrategyOptions::pick_in_view) further out
   // where the camera sees the object whole, so that the look on arrival checks it is still
-  // there (a camera that looks down loses near objects below its view).
+  // there (a camera that looks down loses near objects below its view), by the error an
+  // arrival leaves on top (MatchSetup::arrival_slack_m's default, half approach_margin_m).
   double PickMargin(const StrategyContext& c, const std::string& kind) const {
     const field::ObjectType* type = c.season->FindObjectType(kind);
     if (!options_.pick_in_view || !perceives() || !type) return options_.approach_margin_m;
@@ -227,9 +228,10 @@ class Base : public Strategy {
       const double in_view =
           platform::NearestWholeInView(c.robot->camera, type->size_m, type->height_m,
                                        options_.view_margin_rad, PickDistance(*c.robot, r) + 1.0);
+      const double slack = 0.5 * options_.approach_margin_m;
       it = pick_margins_
-               .emplace(kind,
-                        std::max(options_.approach_margin_m, in_view - PickDistance(*c.robot, r)))
+               .emplace(kind, std::max(options_.approach_margin_m,
+                                       in_view + slack - PickDistance(*c.robot, r)))
                .first;
     }
     return it->second;

@@ -109,7 +109,8 @@ struct StrategyOptions {
   // whole (at least approach_margin_m), and the executive gives the pick up when the look on
   // arrival does not find it (pushed away, or never there). The view's edges less
   // view_margin_rad (as SlamOOptions::fov_margin_rad). Off: it made more picks take their
-  // target but scored less (the longer approach costs time; README "Looking before a pick").
+  // target but scored less (the longer approach costs time; README, #15, "Then: a pick that
+  // found nothing forgets its target...").
   bool pick_in_view = false;
   double view_margin_rad = 0.05;
   double push_run_in_m = 0.35;     // knock: straight run-in to the object on a raised structure

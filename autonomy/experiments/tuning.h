@@ -79,8 +79,10 @@ struct ComboSummary {
   int overruns = 0;  // matches with motors driven after the deadline
   double mean_overrun_s = 0.0;
   double mean_ate_m = 0.0;
-  double nees_honest_fraction = 0.0;      // over all updates: NEES in its band or below
-  double attempts_inside_fraction = 0.0;  // over all picks/scores: error inside 3-sigma
+  double nees_honest_fraction = 0.0;  // over all updates: NEES in its band or below
+  // Over all picks (skipped ones too: the pose is checked when the pick starts) and scores:
+  // the true error inside 3-sigma.
+  double attempts_inside_fraction = 0.0;
   // Picks that took their target, another object, nothing; releases that scored in the goal
   // aimed at (fractions of the attempts; NaN: none). Picks given up before the approach
   // (the look on arrival did not find the target) are not attempts: counted apart.

@@ -66,7 +66,8 @@ struct AttemptCheck {
   // -1 when there was none.
   int target_truth_id = -1;
   double target_error_m = -1.0;
-  // PICK: "target" (the intake took that object), "other" (it took another), "nothing".
+  // PICK: "target" (the intake took that object), "other" (it took another), "nothing",
+  // "skipped" (given up before the approach: the look there did not find the target).
   // SCORE: "scored" (in the goal aimed at), "missed" (released elsewhere), "nothing" (nothing
   // left the intake). KNOCK: "scored" (the object came down into the zone aimed at), "off"
   // (it came down elsewhere), "nothing" (it is still up there, or there was none).
@@ -75,7 +76,7 @@ struct AttemptCheck {
   std::string taken_kind, taken_colour;
 };
 inline constexpr double kTargetMatch_m = 0.5;
-const std::vector<std::string>& PickOutcomes();   // target, other, nothing
+const std::vector<std::string>& PickOutcomes();   // target, other, nothing, skipped
 const std::vector<std::string>& ScoreOutcomes();  // scored, missed, nothing
 const std::vector<std::string>& KnockOutcomes();  // scored, off, nothing
 

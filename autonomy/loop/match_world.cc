@@ -590,30 +590,29 @@ bool MatchWorld::Pick(const strategy::Action& action) {
   for (const strategy::ObjectBelief& o : before.objects) {
     if (o.id == action.object_id) target = o, believed = true;
   }
-  // The look on arrival, from where the camera sees the target whole
+  if (perceive_ && frames_at_rest_ == 0) {
+    Observe(std::max(action.frames, setup_.correction_frames));
+    believed = false;
+    for (const strategy::ObjectBelief& o : Belief().objects) {
+      if (o.id == action.object_id) target = o, believed = true;
+    }
+  }
+  // The look since the robot came to rest here, from where the camera sees the target whole
   // (StrategyOptions::pick_in_view): not seen in it, it is not there (pushed away, or never
   // was): no approach. Lost from the map since the strategy chose it: the same.
   if (perceive_ && setup_.strategy_options.pick_in_view && action.object_id >= 0) {
     bool gone = !believed;
-    if (believed && frames_at_rest_ > 0) {
-      for (const mapping::TrackedObject& o : slam_.ConfirmedObjects(picked_ids_)) {
-        if (o.id != action.object_id || o.last_seen_s >= look_start_s_) continue;
-        if (slam_.WholeInView(slam_.pose(), o)) {
-          slam_.ForgetObject(o.id);
-          UpdateMaps();
-          gone = true;
-        }
+    for (const mapping::TrackedObject& o : slam_.ConfirmedObjects(picked_ids_)) {
+      if (o.id != action.object_id || o.last_seen_s >= look_start_s_) continue;
+      if (frames_at_rest_ > 0 && slam_.WholeInView(slam_.pose(), o)) {
+        slam_.ForgetObject(o.id);
+        UpdateMaps();
+        gone = true;
       }
     }
     if (gone) {
       pick_skipped_ = true;
       return false;
-    }
-  }
-  if (perceive_ && frames_at_rest_ == 0) {
-    Observe(std::max(action.frames, setup_.correction_frames));
-    for (const strategy::ObjectBelief& o : Belief().objects) {
-      if (o.id == action.object_id) target = o;
     }
   }
   const double r =

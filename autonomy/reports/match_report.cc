@@ -482,7 +482,7 @@ void PrintSummary(const MatchResult& r, std::ostream& out) {
     std::map<std::string, int> picks, scores, knocks;
     int n_picks = 0, n_scores = 0, n_knocks = 0;
     for (const AttemptCheck& a : r.attempts) {
-      if (a.action == "PICK") ++picks[a.outcome], ++n_picks;
+      if (a.action == "PICK") ++picks[a.outcome], n_picks += a.outcome != "skipped";
       if (a.action == "SCORE") ++scores[a.outcome], ++n_scores;
       if (a.action == "KNOCK" || a.action == "PUSH") ++knocks[a.outcome], ++n_knocks;
     }

@@ -268,10 +268,11 @@ TEST(SlamOBlocksTest, ANearObjectTakenAwayFadesOnlyWhereTheCameraSeesIt) {
   ASSERT_GT(below_before, 0.0);
   EXPECT_DOUBLE_EQ(below_after, below_before);
   // The distance comes from the mount: the block's near bottom edge on the lowest ray of the
-  // view less the margin (0.64 m for this camera, 0.38 m high, pitched 15 degrees).
+  // view less the margin, in pixels (0.63 m for this camera, 0.38 m high, pitched 15 degrees).
   const field::CameraConfig& camera = robot.camera;
+  const double lowest_v = camera.height_px - camera.fy * std::tan(0.05);
   const double lowest =
-      camera.mount.pitch_deg * kPi / 180.0 + std::atan(camera.cy / camera.fy) - 0.05;
+      camera.mount.pitch_deg * kPi / 180.0 + std::atan((lowest_v - camera.cy) / camera.fy);
   EXPECT_NEAR(platform::NearestWholeInView(camera, block->size_m, block->height_m, 0.05, 2.0),
               camera.mount.x_m + camera.mount.height_m / std::tan(lowest) + block->size_m / 2.0,
               0.015);
