@@ -72,8 +72,9 @@ DriveStep ParseStatement(int index, const std::string& statement) {
   return step;
 }
 
-// The controller: sees only the encoders. `advance` lets one control period pass on the clock
-// (the simulator steps; on hardware the link is serviced while real time runs).
+// The controller: sees the encoders (and a gyro's heading, when the link has one). `advance`
+// lets one control period pass on the clock (the simulator steps; on hardware the link is
+// serviced while real time runs).
 class Runner {
  public:
   Runner(const DriveControllerOptions& options, const DriveBodyLink& body)
@@ -82,11 +83,14 @@ class Runner {
         clock_(body.clock),
         advance_(body.advance),
         truth_(body.truth),
+        gyro_(body.gyro),
         half_track_m_(0.5 * body.track_width_m),
         odometry_(body.metres_per_tick, body.track_width_m, body.base->ReadEncoders(),
                   body.odometry_start),
         heading_rad_(odometry_.pose().theta_rad),
-        intended_heading_rad_(heading_rad_) {}
+        intended_heading_rad_(heading_rad_) {
+    if (gyro_) last_gyro_rad_ = gyro_();
+  }
 
   DriveStepResult Run(const DriveStep& step) {
     DriveStepResult result;
@@ -145,7 +149,13 @@ class Runner {
     advance_(options_.control_dt_s);
     const double before_rad = odometry_.pose().theta_rad;
     odometry_.Update(base_->ReadEncoders());
-    heading_rad_ += WrapAngleRad(odometry_.pose().theta_rad - before_rad);
+    const std::optional<double> gyro = gyro_ ? gyro_() : std::nullopt;
+    if (gyro && last_gyro_rad_) {
+      heading_rad_ += WrapAngleRad(*gyro - *last_gyro_rad_);
+    } else {
+      heading_rad_ += WrapAngleRad(odometry_.pose().theta_rad - before_rad);
+    }
+    last_gyro_rad_ = gyro;  // after a missing reading the next one only starts afresh
   }
 
   // The next wheel speed of a ramp: accelerate to cruise, decelerate to reach 0 at the end.
@@ -156,7 +166,8 @@ class Runner {
     return std::max(ramp, std::min(options_.min_speed_mps, options_.cruise_speed_mps));
   }
 
-  // Turns in place by amount_rad by the encoders; false on timeout.
+  // Turns in place by amount_rad by the heading (the encoders', or the gyro's); false on
+  // timeout.
   bool Turn(double amount_rad, double deadline_s) {
     const double target_rad = heading_rad_ + amount_rad;
     const double sign = amount_rad >= 0.0 ? 1.0 : -1.0;
@@ -252,9 +263,11 @@ class Runner {
   const Clock* clock_;
   std::function<void(double)> advance_;
   std::function<Pose2D()> truth_;
+  std::function<std::optional<double>()> gyro_;
+  std::optional<double> last_gyro_rad_;  // the gyro's last reading
   double half_track_m_;
   EncoderOdometry odometry_;
-  double heading_rad_;           // odometry heading, unwrapped
+  double heading_rad_;           // heading (encoders, or the gyro's changes), unwrapped
   double intended_heading_rad_;  // sum of the script's turns, unwrapped
 };
 

@@ -1,13 +1,14 @@
 // Drive scripts: "forward 0.3; turn 90; back 0.2; wait 1" parsed into steps and driven on any
 // DriveBase (the simulator's: platform/sim/sim_drive_script.h) by a closed-loop controller that
-// knows only the encoders (turn, then drive holding heading, with speed ramps), the way the real
-// robot will be driven. After each step the result holds the true pose and the encoder-odometry
-// pose.
+// knows the encoders, and a yaw gyro when the link has one (turn, then drive holding heading,
+// with speed ramps), the way the real robot will be driven. After each step the result holds
+// the true pose and the encoder-odometry pose.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -97,6 +98,12 @@ struct DriveBodyLink {
   const Clock* clock = nullptr;
   std::function<void(double)> advance;
   std::function<Pose2D()> truth;
+  // A yaw gyro's heading (rad, counter-clockwise positive as the odometry's; only its changes
+  // matter), when the robot has one: turns and the
+  // heading held on a drive are then closed on it, as V5 teams turn on the inertial sensor,
+  // not on the encoders, whose turn is wrong whenever a wheel slips. A reading of nothing (or
+  // no function) leaves that period to the encoders.
+  std::function<std::optional<double>()> gyro;
 };
 
 // Drives `steps` on `body`. Throws std::invalid_argument for a link without a base, clock or

@@ -90,6 +90,9 @@ const std::map<std::string, std::string>& TunableParams() {
        "without one (0: only what it pushes out of time)"},
       {"gyro", "1: a yaw gyro's heading into SLAM-O; 0: encoders and camera only"},
       {"adaptive", "1: the EKF's adaptive noise (NIS, sensor/motion checks, re-acquire); 0: off"},
+      {"gyro_turns",
+       "1: the drive controller turns and holds heading on the gyro (robots with an imu, gyro=1); "
+       "0: on the encoders"},
       {"planner", "OMPL planner: rrtconnect | rrtstar | informedrrtstar | prmstar | bitstar"},
   };
   return params;
@@ -158,6 +161,10 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     if (value != "0" && value != "1")
       throw std::invalid_argument("--param gyro: expected 0 or 1, got \"" + value + "\"");
     setup->gyro = value == "1";
+  } else if (name == "gyro_turns") {
+    if (value != "0" && value != "1")
+      throw std::invalid_argument("--param gyro_turns: expected 0 or 1, got \"" + value + "\"");
+    setup->gyro_turns = value == "1";
   } else if (name == "adaptive") {
     if (value != "0" && value != "1")
       throw std::invalid_argument("--param adaptive: expected 0 or 1, got \"" + value + "\"");

@@ -290,6 +290,10 @@ void MatchWorld::KeepView(const platform::RgbdFrame& frame, const mapping::Objec
 
 bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   platform::DriveBodyLink body = DriveLinkFor(*io_, robot_);
+  // Turns closed on the gyro (opt-in): a robot file with an inertial sensor, gyro-aided.
+  if (setup_.gyro_turns && setup_.gyro && robot_.imu) {
+    body.gyro = [this]() { return io_->GyroHeadingRad(); };
+  }
   body.advance = [this](double dt) {
     Advance(dt);
     MaybeSnapshot();

@@ -76,6 +76,11 @@ struct MatchSetup {
   bool gyro =
       true;  // the turn of every motion from a yaw gyro, not the encoders (VEX robots carry one)
   bool adaptive_filter = false;  // the EKF's adaptive noise (mapping::AdaptiveOptions)
+  // The drive controller turns and holds heading on the gyro instead of the encoders (robot
+  // files with an `imu`, with `gyro` on). Off: on the V5 robot it lifts the blind scripted
+  // route more than the planner (README, #15: "Then: turns cut at the wheels' measured
+  // speed").
+  bool gyro_turns = false;
 };
 
 // What the camera saw on the last frame whose objects were detected (the first and the last
