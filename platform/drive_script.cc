@@ -172,9 +172,17 @@ class Runner {
     const double target_rad = heading_rad_ + amount_rad;
     const double sign = amount_rad >= 0.0 ? 1.0 : -1.0;
     double speed_mps = 0.0;
+    double last_rad = heading_rad_;
     while (true) {
       const double remaining_m = sign * (target_rad - heading_rad_) * half_track_m_;
-      if (remaining_m <= speed_mps * options_.stop_lead_s) break;
+      // The wheels lag the ramp down, so they turn faster than commanded and coast further
+      // once cut: the cut is timed at the faster of the two.
+      const double turning_mps =
+          options_.lead_on_measured_speed
+              ? sign * (heading_rad_ - last_rad) * half_track_m_ / options_.control_dt_s
+              : 0.0;
+      last_rad = heading_rad_;
+      if (remaining_m <= std::max(speed_mps, turning_mps) * options_.stop_lead_s) break;
       if (clock_->NowS() >= deadline_s) {
         Settle();
         return false;

@@ -51,7 +51,11 @@ struct DriveControllerOptions {
   double heading_gain_per_s = 2.0;   // yaw-rate command per radian of heading error (1/s)
   double align_tolerance_deg = 1.0;  // a drive turns first if the heading is off by more (deg)
   double stop_lead_s = 0.05;         // stop this long before the target at the commanded speed (s)
-  double settle_s = 0.1;             // encoders still this long ends a step (s)...
+  // A turn is cut stop_lead_s before its target at the measured turning speed when that is the
+  // faster (the wheels trail the ramp down): less overshoot, fewer correcting turns. Off: at
+  // the commanded speed.
+  bool lead_on_measured_speed = false;
+  double settle_s = 0.1;  // encoders still this long ends a step (s)...
   // ...or, when above 0, moving at most this many ticks per wheel over the last settle_s (by
   // the readings' clock, back and forth counted). A first-order motor lag with time constant
   // tau coasts speed x tau once cut, and over a window T >= tau it covers speed x tau x

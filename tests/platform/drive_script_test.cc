@@ -262,6 +262,41 @@ TEST(DriveScriptGyroTest, TurnsClosedOnTheGyroFollowTheBodyNotTheWheels) {
   EXPECT_LT(gyro_worst_deg, 6.0);
 }
 
+// A turn cut at the commanded speed overshoots: during the ramp down the wheels trail the
+// command and coast on after the cut. Timed at the measured turning speed it stops nearer.
+TEST(DriveScriptSettleTest, ATurnCutAtItsMeasuredSpeedOvershootsLess) {
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  ASSERT_TRUE(robot.drive.slip.has_value());
+  const auto mean_overshoot_deg = [&](bool measured) {
+    double sum = 0.0;
+    int n = 0;
+    for (uint64_t seed = 1; seed <= 20; ++seed) {
+      SimDriveBase sim(robot.drive, SimDriveOptionsFor(robot.drive), seed);
+      SimClock clock;
+      DriveControllerOptions options = DriveControllerOptionsFor(robot.drive);
+      options.cruise_speed_mps = robot.drive.match_speed_mps;  // as in a match
+      options.stop_lead_s = robot.drive.slip->motor_time_constant_s;
+      options.lead_on_measured_speed = measured;
+      const std::vector<DriveStepResult> results = RunDriveScript(
+          ParseDriveScript("turn 90; wait 0.3; turn -45; wait 0.3; turn 30; wait 0.3"), options,
+          &sim, &clock);
+      for (const DriveStepResult& r : results) EXPECT_EQ(r.status, DriveStepStatus::kDone);
+      // By the encoders, after the coast (each wait), against the sum of the turns asked
+      // (over- or undershoot).
+      const double asked_deg[] = {90.0, 45.0, 75.0};
+      for (int k = 0; k < 3; ++k) {
+        sum += std::abs(results[2 * k + 1].odometry_pose.theta_rad * kDegPerRad - asked_deg[k]);
+        ++n;
+      }
+    }
+    return sum / n;
+  };
+  const double commanded = mean_overshoot_deg(false), measured = mean_overshoot_deg(true);
+  std::cout << "mean turn error by the encoders: cut at the commanded speed " << commanded
+            << " deg, at the measured " << measured << " deg\n";
+  EXPECT_LT(measured, 0.7 * commanded);
+}
+
 // Drift statistics over many seeds: the calibration the simulator's defaults promise
 // (thesis appendix B: 0.05 m per 0.3 m, 2 deg spread per 90 deg turn, ~0.1 m turn slip).
 struct Stats {
