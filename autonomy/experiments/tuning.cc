@@ -40,6 +40,13 @@ int ToInt(const std::string& name, const std::string& value) {
   return static_cast<int>(v);
 }
 
+// A switch: "1" or "0".
+bool ToFlag(const std::string& name, const std::string& value) {
+  if (value != "0" && value != "1")
+    throw std::invalid_argument("--param " + name + ": expected 0 or 1, got \"" + value + "\"");
+  return value == "1";
+}
+
 // Set-up every match process would otherwise repeat for itself, the same whatever the match:
 // done once before the first fork, and inherited. OpenCV builds its BGR-to-Lab tables on the
 // first conversion (the detectors' colour classes): about 0.17 s of CPU, more than a whole
@@ -137,13 +144,9 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
   } else if (name == "arrival_slack") {
     setup->arrival_slack_m = ToDouble(name, value);
   } else if (name == "floor_push") {
-    if (value != "0" && value != "1")
-      throw std::invalid_argument("--param floor_push: expected 0 or 1, got \"" + value + "\"");
-    setup->strategy_options.floor_pushes = value == "1";
+    setup->strategy_options.floor_pushes = ToFlag(name, value);
   } else if (name == "push_loss") {
-    if (value != "0" && value != "1")
-      throw std::invalid_argument("--param push_loss: expected 0 or 1, got \"" + value + "\"");
-    setup->strategy_options.count_push_loss = value == "1";
+    setup->strategy_options.count_push_loss = ToFlag(name, value);
   } else if (name == "reverse_max") {
     setup->reverse_max_m = ToDouble(name, value);
   } else if (name == "pushable") {
@@ -151,24 +154,16 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
   } else if (name == "arrival_frames") {
     setup->strategy_options.arrival_frames = ToInt(name, value);
   } else if (name == "observe_first") {
-    if (value != "0" && value != "1")
-      throw std::invalid_argument("--param observe_first: expected 0 or 1");
     setup->strategy_options.frame_choices =
-        value == "1" ? std::vector<int>{0, 5, 10, 20} : std::vector<int>{0};
+        ToFlag(name, value) ? std::vector<int>{0, 5, 10, 20} : std::vector<int>{0};
   } else if (name == "look_charge") {
     setup->strategy_options.look_charge = ToDouble(name, value);
   } else if (name == "gyro") {
-    if (value != "0" && value != "1")
-      throw std::invalid_argument("--param gyro: expected 0 or 1, got \"" + value + "\"");
-    setup->gyro = value == "1";
+    setup->gyro = ToFlag(name, value);
   } else if (name == "gyro_turns") {
-    if (value != "0" && value != "1")
-      throw std::invalid_argument("--param gyro_turns: expected 0 or 1, got \"" + value + "\"");
-    setup->gyro_turns = value == "1";
+    setup->gyro_turns = ToFlag(name, value);
   } else if (name == "adaptive") {
-    if (value != "0" && value != "1")
-      throw std::invalid_argument("--param adaptive: expected 0 or 1, got \"" + value + "\"");
-    setup->adaptive_filter = value == "1";
+    setup->adaptive_filter = ToFlag(name, value);
   } else if (name == "planner") {
     const auto& names = planning::PlannerNames();
     if (std::find(names.begin(), names.end(), value) == names.end()) {
