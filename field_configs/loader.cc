@@ -531,7 +531,7 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   const YamlReader camera = root.Required("camera");
   camera.AllowKeys({"model", "width_px", "height_px", "cx", "cy", "fx", "fy", "min_range_m",
                     "max_range_m", "frame_rate_hz", "colour_depth_baseline_m", "mount", "noise",
-                    "depth_correction", "stop_bias"});
+                    "depth_correction", "stop_bias", "latency_s"});
   CameraConfig& c = robot->camera;
   c.model = camera.Required("model").String();
   c.width_px = camera.Required("width_px").IntInRange(16, 8192);
@@ -546,6 +546,9 @@ void ParseRobot(const YamlReader& root, RobotConfig* robot) {
   if (c.max_range_m <= c.min_range_m) max_range.Fail("a range above min_range_m");
   c.frame_rate_hz = camera.Required("frame_rate_hz").InRange(0.1, 1000.0);
   c.colour_depth_baseline_m = camera.Required("colour_depth_baseline_m").InRange(-0.5, 0.5);
+  if (const std::optional<YamlReader> v = camera.Optional("latency_s")) {
+    c.latency_s = v->InRange(0.0, 0.5);
+  }
 
   const YamlReader mount = camera.Required("mount");
   mount.AllowKeys({"x_m", "y_m", "height_m", "pitch_deg", "yaw_deg"});

@@ -126,6 +126,10 @@ struct CameraConfig {
   // SLAM-O's iterated-frame covariance (mapping::IteratedFrameCovariance) for its markers.
   double stop_bias_range_sigma_m = 0.0;
   double stop_bias_bearing_sigma_deg = 0.0;
+  // From a frame's exposure to when the program has it (s): a frame taken on the move shows
+  // the robot where it was this long before the encoders' latest reading. The simulator
+  // renders it so; SLAM-O pairs such a frame with the odometry of its exposure.
+  double latency_s = 0.0;
 };
 
 struct IntakeConfig {

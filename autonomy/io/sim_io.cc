@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <optional>
 #include <random>
 #include <vector>
@@ -59,6 +60,13 @@ class SimIo : public RobotIo {
   void Advance(double dt_s) override {
     sim_->Step(dt_s);
     clock_.Advance(dt_s);
+    if (robot_.camera.latency_s > 0.0) {
+      // The poses a frame with the camera's latency may show.
+      history_.push_back({clock_.NowS(), sim_->robot_pose()});
+      while (history_.size() > 2 && history_[1].first < clock_.NowS() - robot_.camera.latency_s) {
+        history_.pop_front();
+      }
+    }
   }
   Pose2D OdometryPose() const override { return sim_->drive().odometry_pose(); }
   bool MotorsDriven() const override {
@@ -68,8 +76,11 @@ class SimIo : public RobotIo {
   std::optional<double> GyroHeadingRad() override {
     return gyro_.Read(sim_->robot_pose().theta_rad, clock_.NowS());
   }
+  // The frame exposed camera.latency_s ago: where the robot was then (between the two
+  // controller periods about it), stamped with that time.
   std::optional<platform::RgbdFrame> Capture() override {
-    return renderer_->Render(sim_->world(), sim_->robot_pose(), clock_.NowS(), nullptr);
+    const double t_s = clock_.NowS() - robot_.camera.latency_s;
+    return renderer_->Render(sim_->world(), PoseAt(t_s), t_s, nullptr);
   }
   std::optional<IntakeItem> Pick(const strategy::ObjectBelief&) override {
     const std::optional<int> picked = sim_->Pick();
@@ -100,6 +111,17 @@ class SimIo : public RobotIo {
   std::string Describe() const override { return "simulated field"; }
 
  private:
+  Pose2D PoseAt(double t_s) const {
+    if (history_.empty() || t_s >= history_.back().first) return sim_->robot_pose();
+    if (t_s <= history_.front().first) return history_.front().second;
+    size_t k = 1;
+    while (history_[k].first < t_s) ++k;
+    const auto& [t0, a] = history_[k - 1];
+    const auto& [t1, b] = history_[k];
+    const double f = (t_s - t0) / (t1 - t0);
+    return Pose2D{a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m),
+                  a.theta_rad + f * platform::WrapAngleRad(b.theta_rad - a.theta_rad)};
+  }
   std::optional<IntakeItem> Item(int id) const {
     for (const platform::SimObject& o : sim_->world().objects) {
       if (o.id == id) return IntakeItem{o.type->name, o.colour, false};
@@ -117,6 +139,7 @@ class SimIo : public RobotIo {
   std::unique_ptr<platform::SimField> sim_;
   std::unique_ptr<platform::SimRenderer> renderer_;
   platform::SimGyro gyro_;
+  std::deque<std::pair<double, Pose2D>> history_;  // (time, true pose), camera.latency_s back
 };
 
 }  // namespace

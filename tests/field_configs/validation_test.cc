@@ -228,5 +228,15 @@ TEST_F(RobotValidationTest, IntakeTimesAreReadAndBounded) {
   EXPECT_EQ(negative.key_path(), "intake.pick_s");
 }
 
+// The camera's latency (frames taken while driving): none when left out, read, and bounded.
+TEST_F(RobotValidationTest, CameraLatencyIsOptionalAndBounded) {
+  EXPECT_DOUBLE_EQ(ParseRobotConfig(text_, "r.yaml").camera.latency_s, 0.0);
+  const std::string with =
+      Edit(text_, "  frame_rate_hz: 30.0", "  frame_rate_hz: 30.0\n  latency_s: 0.04");
+  EXPECT_DOUBLE_EQ(ParseRobotConfig(with, "r.yaml").camera.latency_s, 0.04);
+  const ConfigError e = Reject(Edit(with, "latency_s: 0.04", "latency_s: 2"));
+  EXPECT_EQ(e.key_path(), "camera.latency_s");
+}
+
 }  // namespace
 }  // namespace slamo::field

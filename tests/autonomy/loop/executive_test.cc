@@ -609,12 +609,14 @@ TEST(Executive, WithPickInViewAPickWhoseTargetIsGoneIsSkipped) {
 // A look before a cycle is charged the time it takes at the best rate of the sequences without
 // one: the search sees only two cycles ahead, and without the charge a look that lifts a
 // release's modelled chance by a little was free whenever both sequences fit. Push Back
-// nominal seed 87: 3 looks before cycles instead of 5, and the second release ends in time
-// (3 points without the charge, 6 with it; 200 seeds +0.045 nominal, +0.03 disturbed when it
-// came; seed 68, the case first, maps its blocks differently since the pieces split by size
-// stopped overlapping and scores 6 either way. 6 of 200 nominal seeds then scored 3 more with
-// the charge, none less: `slamo tune --season push_back --robot v5_drivetrain --matches 200
-// --param strategy=planner --param look_charge=0,1`).
+// nominal seed 73: 1 look before a cycle instead of 5, and the second release ends in time (3
+// points without the charge, 6 with it; 200 seeds +0.045 nominal, +0.03 disturbed when it came).
+// The seed is one of those where the charge pays: seed 68, the case first, maps its blocks
+// differently since the pieces split by size stopped overlapping; seed 87, the next, scores 3
+// either way since the simulator renders the camera's latency (frames taken as the wheels
+// coast out after a drive). Now 6 of 200 nominal seeds score 3 more with the charge (37, 73,
+// 78, 134, 135, 179), none less: `slamo tune --season push_back --robot v5_drivetrain
+// --matches 200 --param strategy=planner --param look_charge=0,1`, 5.85 -> 5.94.
 TEST(Executive, ALookBeforeACycleIsChargedItsTime) {
   const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
@@ -622,7 +624,7 @@ TEST(Executive, ALookBeforeACycleIsChargedItsTime) {
     MatchSetup setup;
     setup.strategy = "planner";
     setup.strategy_options.look_charge = look_charge;
-    const MatchResult r = RunMatch(season, robot, setup, 87);
+    const MatchResult r = RunMatch(season, robot, setup, 73);
     EXPECT_EQ(r.overrun_s, 0.0);
     int looks = 0;
     for (const TimelineEntry& e : r.timeline)
