@@ -333,6 +333,7 @@ MatchResult RunLoop(std::unique_ptr<strategy::Strategy> strategy, MatchWorld& wo
   result.pose_ate_m = PoseAte(world.samples());
   result.consistency = PoseConsistencyOf(world.samples());
   result.frames_taken = world.frames();
+  result.moving_frames = world.moving_frames();
   result.replans = world.replans();
   result.relocalisations = world.relocalisations();
   result.rejected_frames = world.rejected_frames();

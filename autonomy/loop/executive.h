@@ -99,6 +99,7 @@ struct MatchResult {
                             // no truth)
   double observe_s = 0.0, drive_s = 0.0, score_s = 0.0, idle_s = 0.0;
   int frames_taken = 0;
+  int moving_frames = 0;  // of frames_taken: while driving (MatchSetup::moving_frame_period_s)
   int replans = 0;
   int relocalisations = 0;      // frames paired again after widening a lost pose belief
   int rejected_frames = 0;      // frames whose update would have thrown the pose off

@@ -299,10 +299,45 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   if (setup_.gyro_turns && setup_.gyro && robot_.imu) {
     body.gyro = [this]() { return io_->GyroHeadingRad(); };
   }
-  body.advance = [this](double dt) {
+  // Frames on the move: on straight drives, one every moving_frame_period_s (at least the
+  // camera's latency, so that a frame's exposure never comes before the last prediction) while
+  // the body holds its heading.
+  const bool straight = std::any_of(steps.begin(), steps.end(), [](const DriveStep& s) {
+    return s.kind == platform::DriveStepKind::kDrive;
+  });
+  const bool look_moving = perceive_ && straight && setup_.moving_frame_period_s > 0.0;
+  const double frame_period_s = std::max(setup_.moving_frame_period_s, robot_.camera.latency_s);
+  double last_frame_s = now_s();
+  Pose2D last_odometry = io_->OdometryPose();
+  // The readings of the last camera latency (and one before), to pair a frame with, from the
+  // drive's start on.
+  std::deque<OdometryReading> recent;
+  if (look_moving && robot_.camera.latency_s > 0.0) {
+    recent.push_back({now_s(), last_odometry, setup_.gyro ? io_->GyroHeadingRad() : std::nullopt});
+  }
+  body.advance = [&, this](double dt) {
     Advance(dt);
     MaybeSnapshot();
+    if (!look_moving) return;
+    const Pose2D odometry = io_->OdometryPose();
+    if (robot_.camera.latency_s > 0.0) {
+      recent.push_back({now_s(), odometry, setup_.gyro ? io_->GyroHeadingRad() : std::nullopt});
+      while (recent.size() > 2 && recent[1].t_s < now_s() - robot_.camera.latency_s) {
+        recent.pop_front();
+      }
+    }
+    const double turned_deg =
+        std::abs(platform::WrapAngleRad(odometry.theta_rad - last_odometry.theta_rad)) * 180.0 /
+        kPi;
+    const bool moved =
+        std::hypot(odometry.x_m - last_odometry.x_m, odometry.y_m - last_odometry.y_m) > 1e-4;
+    last_odometry = odometry;
+    if (!moved || turned_deg > setup_.moving_frame_max_turn_dps * dt) return;
+    if (now_s() + 1e-9 < last_frame_s + frame_period_s) return;
+    if (now_s() >= deadline_s_) return;
+    if (ObserveMoving(recent)) last_frame_s = now_s();  // none: the next period tries again
   };
+  const int moving_before = moving_frames_;
   const Eigen::Vector3d start = slam_.pose();
   const std::vector<platform::DriveStepResult> results =
       platform::RunDriveScript(steps, drive_options_, body);
@@ -310,20 +345,7 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
                   [](const DriveStep& s) { return s.kind != platform::DriveStepKind::kWait; })) {
     frames_at_rest_ = 0;
   }
-  const Pose2D now = io_->OdometryPose();
-  mapping::OdometryStep u = mapping::OdometryIncrement(odometry_, now);
-  u.dx_m *= odometry_scale_;
-  u.dy_m *= odometry_scale_;
-  if (setup_.gyro) {
-    // Gyro-aided odometry: the turn comes from the gyro, which sees the body turn; the
-    // encoders' turn is wrong whenever a wheel slips (and a turn blocked by a pinned object
-    // spins the wheels without turning the robot at all).
-    const double heading = io_->GyroHeadingRad().value_or(gyro_heading_);
-    u.dtheta_rad = platform::WrapAngleRad(heading - gyro_heading_);
-    gyro_heading_ = heading;
-  }
-  slam_.Predict(u);
-  odometry_ = now;
+  PredictFromOdometry();
   const bool done =
       std::all_of(results.begin(), results.end(), [](const platform::DriveStepResult& r) {
         return r.status == platform::DriveStepStatus::kDone;
@@ -331,15 +353,68 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   // Not after a blocked step: wheels slipping against an object carry the estimate past it.
   // Objects the footprint met on the way were pushed: not where they were believed (on a
   // drive that goes straight; a turn's slip is no way).
-  const bool straight = std::any_of(steps.begin(), steps.end(), [](const DriveStep& s) {
-    return s.kind == platform::DriveStepKind::kDrive;
-  });
   if (done) {
     slam_.ForgetObjectsUnderRobot(robot_.length_m, robot_.width_m,
                                   straight ? std::optional<Eigen::Vector3d>(start) : std::nullopt);
   }
+  if (moving_frames_ > moving_before) UpdateMaps();  // what the frames on the way saw
   RecordSample();
   return done;
+}
+
+void MatchWorld::PredictFromOdometry() {
+  PredictTo(io_->OdometryPose(), setup_.gyro ? io_->GyroHeadingRad() : std::nullopt);
+}
+
+void MatchWorld::PredictTo(const Pose2D& odometry, const std::optional<double>& gyro) {
+  mapping::OdometryStep u = mapping::OdometryIncrement(odometry_, odometry);
+  u.dx_m *= odometry_scale_;
+  u.dy_m *= odometry_scale_;
+  if (setup_.gyro) {
+    // Gyro-aided odometry: the turn comes from the gyro, which sees the body turn; the
+    // encoders' turn is wrong whenever a wheel slips (and a turn blocked by a pinned object
+    // spins the wheels without turning the robot at all).
+    const double heading = gyro.value_or(gyro_heading_);
+    u.dtheta_rad = platform::WrapAngleRad(heading - gyro_heading_);
+    gyro_heading_ = heading;
+  }
+  slam_.Predict(u);
+  odometry_ = odometry;
+}
+
+bool MatchWorld::ObserveMoving(const std::deque<OdometryReading>& recent) {
+  std::optional<platform::RgbdFrame> captured = io_->Capture();
+  if (!captured) return false;
+  // The frame shows the robot camera.latency_s ago: the filter is moved to that instant by
+  // the readings about it (interpolated), updated, and moved on to now.
+  const double exposed_s = now_s() - robot_.camera.latency_s;
+  if (recent.size() < 2 || exposed_s >= recent.back().t_s) {
+    PredictFromOdometry();
+  } else {
+    size_t k = 1;
+    while (k + 1 < recent.size() && recent[k].t_s < exposed_s) ++k;
+    const OdometryReading& a = recent[k - 1];
+    const OdometryReading& b = recent[k];
+    const double f = std::clamp((exposed_s - a.t_s) / (b.t_s - a.t_s), 0.0, 1.0);
+    const Pose2D odometry{a.odometry.x_m + f * (b.odometry.x_m - a.odometry.x_m),
+                          a.odometry.y_m + f * (b.odometry.y_m - a.odometry.y_m),
+                          a.odometry.theta_rad + f * platform::WrapAngleRad(b.odometry.theta_rad -
+                                                                            a.odometry.theta_rad)};
+    std::optional<double> gyro;
+    if (a.gyro && b.gyro) gyro = *a.gyro + f * platform::WrapAngleRad(*b.gyro - *a.gyro);
+    PredictTo(odometry, gyro);
+  }
+  mapping::FrameSelectionOptions one = setup_.frames;
+  one.rule = mapping::FrameRule::kFixed;
+  one.fixed_frames = one.max_frames = 1;
+  slam_.BeginStop(one);
+  slam_.UpdateLandmarks(*captured);
+  KeepView(*captured, slam_.TrackObjects(*captured, now_s()));
+  ++frames_;
+  ++moving_frames_;
+  PredictFromOdometry();  // on to now
+  RecordSample();
+  return true;
 }
 
 void MatchWorld::Wait(double seconds) { Drive({DriveStep{DriveStepKind::kWait, seconds, "wait"}}); }

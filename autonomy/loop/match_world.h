@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <random>
@@ -81,6 +82,14 @@ struct MatchSetup {
   // route more than the planner (README, #15: "Then: turns cut at the wheels' measured
   // speed").
   bool gyro_turns = false;
+  // Frames taken while driving past objects (#15 item 5), one every moving_frame_period_s of a
+  // straight drive (0: only at stops), each its own stop of one frame, when the body turned by
+  // at most moving_frame_max_turn_dps over the last control period (a frame taken mid-turn
+  // smears, and the heading the update pairs it at moves fastest then). Tried in the simulator
+  // only: on the robot the capture (up to HardwareIoOptions::frame_wait_s) and the frame's
+  // processing run inside the drive controller's period, whose motor command stands meanwhile.
+  double moving_frame_period_s = 0.0;
+  double moving_frame_max_turn_dps = 20.0;
 };
 
 // What the camera saw on the last frame whose objects were detected (the first and the last
@@ -206,6 +215,7 @@ class MatchWorld {
   const std::vector<Eigen::Vector2d>& landmark_truth() const { return markers_; }
   double overrun_s() const { return overrun_s_; }
   int frames() const { return frames_; }
+  int moving_frames() const { return moving_frames_; }  // of frames(): taken while driving
   int replans() const { return replans_; }
   int relocalisations() const { return slam_.relocalisations(); }
   int rejected_frames() const { return slam_.gated_frames(); }
@@ -217,6 +227,18 @@ class MatchWorld {
   bool Drive(const std::vector<platform::DriveStep>& steps);
   void Wait(double seconds);
   void Advance(double dt_s);
+  // The encoders' (and gyro's) motion since the last prediction into SLAM-O: up to now, or up
+  // to `odometry` and the gyro's `gyro` (nothing: the encoders' turn, without setup_.gyro).
+  void PredictFromOdometry();
+  void PredictTo(const platform::Pose2D& odometry, const std::optional<double>& gyro);
+  struct OdometryReading {
+    double t_s = 0.0;
+    platform::Pose2D odometry;
+    std::optional<double> gyro;
+  };
+  // One frame taken on the move: its markers and objects, a stop of its own, paired with the
+  // odometry of its exposure (camera.latency_s before now) from `recent`. False: no frame.
+  bool ObserveMoving(const std::deque<OdometryReading>& recent);
   void RecordSample();
   void MaybeSnapshot(bool force = false);
   // Keeps `frame` and its detections for the replay, when snapshots are recorded.
@@ -257,6 +279,7 @@ class MatchWorld {
   double overrun_s_ = 0.0;
   double last_motion_s_ = 0.0;
   int frames_ = 0;
+  int moving_frames_ = 0;
   int replans_ = 0;
 };
 

@@ -190,6 +190,7 @@ nlohmann::json ReportJson(const MatchResult& r) {
                   {"pick_score", r.score_s},
                   {"idle", r.idle_s}};
   j["frames_taken"] = r.frames_taken;
+  j["moving_frames"] = r.moving_frames;
   j["replans"] = r.replans;
   j["relocalisations"] = r.relocalisations;
   j["rejected_frames"] = r.rejected_frames;
@@ -467,8 +468,9 @@ void PrintSummary(const MatchResult& r, std::ostream& out) {
       << Fixed(r.idle_s, 1) << " s\n";
   out << "  pose ATE        "
       << (std::isnan(r.pose_ate_m) ? std::string("unknown") : Fixed(r.pose_ate_m, 4) + " m") << " ("
-      << r.samples.size() << " filter updates, " << r.frames_taken << " frames, " << r.replans
-      << " replans, " << r.relocalisations << " relocalisations)\n";
+      << r.samples.size() << " filter updates, " << r.frames_taken << " frames"
+      << (r.moving_frames > 0 ? " (" + std::to_string(r.moving_frames) + " while driving)" : "")
+      << ", " << r.replans << " replans, " << r.relocalisations << " relocalisations)\n";
   if (r.consistency.updates > 0) {
     const PoseConsistency& c = r.consistency;
     int inside = 0;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -767,6 +768,43 @@ TEST(Executive, MotionStopsAtTheDeadlineEvenWhenTheEstimateWasWrong) {
   EXPECT_LE(r.duration_s, 5.0 + 1e-9);
   EXPECT_GT((r.samples.back().truth - r.samples.front().truth).head<2>().norm(), 0.05)
       << "it did drive";
+}
+
+// Frames while driving (#15 item 5): every 0.2 s of a straight drive a frame goes into
+// SLAM-O, paired with the odometry of its exposure camera.latency_s (the V5 robot's 0.05 s,
+// which the simulator renders) before the latest reading. Over Under disturbed, six seeds: the
+// pose error at the filter's updates falls well below the stops-only run's, and the latency
+// costs little against a camera without any. Measured: 0.0180 m stops only, 0.0066 m while
+// driving, 0.0051 m without latency (0.0052 m on a build that read the gyro once less: six
+// seeds are few, the 200-seed sweeps give 0.005-0.007 m either way); paired with the odometry
+// of the moment the frame arrives instead (a throw-away patch), 0.0164 m.
+TEST(Executive, FramesWhileDrivingArePairedWithTheOdometryOfTheirExposure) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("over_under");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  ASSERT_GT(robot.camera.latency_s, 0.0);
+  field::RobotConfig no_latency = robot;
+  no_latency.camera.latency_s = 0.0;
+  double stops = 0.0, moving = 0.0, moving_no_latency = 0.0;
+  const int seeds = 6;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    MatchSetup setup;
+    setup.scenario = Scenario::kDisturbed;
+    const MatchResult a = RunMatch(season, robot, setup, seed);
+    EXPECT_EQ(a.moving_frames, 0);
+    setup.moving_frame_period_s = 0.2;
+    const MatchResult b = RunMatch(season, robot, setup, seed);
+    const MatchResult c = RunMatch(season, no_latency, setup, seed);
+    EXPECT_GT(b.moving_frames, 10) << seed;
+    EXPECT_LT(b.moving_frames, b.frames_taken) << seed;
+    EXPECT_EQ(b.overrun_s, 0.0) << seed;
+    stops += a.pose_ate_m / seeds;
+    moving += b.pose_ate_m / seeds;
+    moving_no_latency += c.pose_ate_m / seeds;
+  }
+  std::printf("ATE m: stops only %.4f, while driving %.4f, no latency %.4f\n", stops, moving,
+              moving_no_latency);
+  EXPECT_LT(moving, 0.5 * stops);
+  EXPECT_LT(moving, 2.0 * moving_no_latency);
 }
 
 }  // namespace
