@@ -9,6 +9,7 @@
 #include <cstring>
 #include <exception>
 #include <utility>
+#include <variant>
 
 #include <mrpt/comms/CSerialPort.h>
 
@@ -154,7 +155,7 @@ void SerialDriveBase::Stop() {
   Poll();
   command_ = serial::Stop{};
   Send(*command_);
-  next_refresh_s_ = clock_.NowS() + options_.command_refresh_s;
+  next_refresh_s_ = clock_.NowS() + options_.stop_refresh_s;
 }
 
 EncoderTicks SerialDriveBase::ReadEncoders() {
@@ -192,9 +193,13 @@ void SerialDriveBase::ClosePort(double now_s) {
 void SerialDriveBase::LoseLink(double now_s) {
   ++stats_.link_losses;
   state_ = transport_->IsOpen() ? LinkState::kWaiting : LinkState::kClosed;
-  // Best effort: the board's watchdog stops the motors whether or not this arrives.
-  command_.reset();
-  Send(serial::Stop{});
+  // The board's watchdog stops the motors only if the host falls silent, and the heartbeats go
+  // on: the stop is resent every stop_refresh_s, link up or not, until the next command (on a
+  // link dropping a fifth of its frames this stop and the one before it were once both lost,
+  // and the motors ran on).
+  command_ = serial::Stop{};
+  Send(*command_);
+  next_refresh_s_ = now_s + options_.stop_refresh_s;
   rebase_ = true;
   heartbeat_outstanding_ = false;
   opened_s_ = now_s;  // the silence before reopening counts from here
@@ -234,9 +239,10 @@ void SerialDriveBase::Poll() {
     }
     next_heartbeat_s_ = std::max(next_heartbeat_s_ + options_.heartbeat_period_s, now_s);
   }
-  if (state_ == LinkState::kUp && command_ && now_s >= next_refresh_s_) {
+  const bool stopping = command_ && std::holds_alternative<serial::Stop>(*command_);
+  if ((state_ == LinkState::kUp || stopping) && command_ && now_s >= next_refresh_s_) {
     Send(*command_);
-    next_refresh_s_ = now_s + options_.command_refresh_s;
+    next_refresh_s_ = now_s + (stopping ? options_.stop_refresh_s : options_.command_refresh_s);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -251,6 +252,39 @@ TEST(FakeBoardTest, SurvivesGarbageDropsDuplicatesAndDelays) {
     EXPECT_GE(now.t_s, last.t_s);
     last = now;
   }
+}
+
+// The longest the motors ran on after Stop() over 40 stops on a link that drops a fifth of
+// its frames.
+double WorstStopDelay(const SerialDriveOptions& host_options) {
+  FakeBoardOptions options;
+  options.faults.drop_probability = 0.2;
+  Rig rig(options, host_options);
+  rig.Run(0.2);
+  double worst_s = 0.0;
+  for (int trial = 0; trial < 40; ++trial) {
+    rig.host.SetPwm(40, 140);
+    rig.Run(0.1);
+    rig.host.Stop();
+    double t = 0.0;
+    while (t < 0.5 && (rig.board.logic().left_pwm() != 90 || rig.board.logic().right_pwm() != 90)) {
+      rig.Run(0.001);
+      t += 0.001;
+    }
+    worst_s = std::max(worst_s, t);
+  }
+  return worst_s;
+}
+
+// A lost stop is sent again within a control period, not at the next command refresh: at the
+// match's deadline the motors must not run on (a 2 % lossy link once drove 0.1 s past it).
+TEST(FakeBoardTest, ALostStopIsResentWithinAControlPeriod) {
+  SerialDriveOptions as_before;
+  as_before.stop_refresh_s = as_before.command_refresh_s;
+  const double before_s = WorstStopDelay(as_before);
+  const double now_s = WorstStopDelay(SerialDriveOptions{});
+  EXPECT_GE(before_s, 0.09);
+  EXPECT_LE(now_s, 0.065);
 }
 
 TEST(FakeBoardTest, BoardIgnoresPureGarbageAndAnswersUnhandledTypes) {
