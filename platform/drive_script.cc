@@ -84,6 +84,7 @@ class Runner {
         advance_(body.advance),
         truth_(body.truth),
         gyro_(body.gyro),
+        correct_(body.correct),
         half_track_m_(0.5 * body.track_width_m),
         odometry_(body.metres_per_tick, body.track_width_m, body.base->ReadEncoders(),
                   body.odometry_start),
@@ -202,12 +203,20 @@ class Runner {
     if (std::abs(misalignment_rad) > options_.align_tolerance_deg * kPi / 180.0) {
       if (!Turn(misalignment_rad, deadline_s)) return false;
     }
-    const Pose2D start = odometry_.pose();
-    const double ux = std::cos(intended_heading_rad_);
-    const double uy = std::sin(intended_heading_rad_);
+    Pose2D start = odometry_.pose();
+    double ux = std::cos(intended_heading_rad_);
+    double uy = std::sin(intended_heading_rad_);
     const double sign = distance_m >= 0.0 ? 1.0 : -1.0;
     double speed_mps = 0.0;
     while (true) {
+      if (const std::optional<DriveCorrection> c = correct_ ? correct_() : std::nullopt) {
+        // Measured from here on: the new heading, and what is left to go along it.
+        intended_heading_rad_ = heading_rad_ + c->heading_change_rad;
+        ux = std::cos(intended_heading_rad_);
+        uy = std::sin(intended_heading_rad_);
+        start = odometry_.pose();
+        distance_m = sign * std::max(0.0, c->remaining_m);
+      }
       const Pose2D& pose = odometry_.pose();
       const double along_m = (pose.x_m - start.x_m) * ux + (pose.y_m - start.y_m) * uy;
       const double remaining_m = std::abs(distance_m) - sign * along_m;
@@ -272,6 +281,7 @@ class Runner {
   std::function<void(double)> advance_;
   std::function<Pose2D()> truth_;
   std::function<std::optional<double>()> gyro_;
+  std::function<std::optional<DriveCorrection>()> correct_;
   std::optional<double> last_gyro_rad_;  // the gyro's last reading
   double half_track_m_;
   EncoderOdometry odometry_;

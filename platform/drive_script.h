@@ -90,6 +90,12 @@ struct DriveStepResult {
   Pose2D odometry_pose;     // what the encoders say (the controller's dead reckoning)
 };
 
+// A correction of a straight drive under way (DriveBodyLink::correct).
+struct DriveCorrection {
+  double heading_change_rad = 0.0;
+  double remaining_m = 0.0;
+};
+
 // What the controller drives: any DriveBase (the simulator's, the serial link to the board),
 // its wheel geometry, the clock, and how time passes. `advance(dt_s)` must let dt_s pass on
 // `clock` (step the simulator and advance a SimClock; or service the link until a real clock
@@ -108,6 +114,11 @@ struct DriveBodyLink {
   // not on the encoders, whose turn is wrong whenever a wheel slips. A reading of nothing (or
   // no function) leaves that period to the encoders.
   std::function<std::optional<double>()> gyro;
+  // Polled every period of a straight drive: a correction from outside the controller (SLAM-O's
+  // estimate, which sees where the body went when the wheels slipped). The drive then holds its
+  // current heading turned by heading_change_rad and has remaining_m (>= 0, encoder metres)
+  // still to go in its own direction. Nothing: carry on.
+  std::function<std::optional<DriveCorrection>()> correct;
 };
 
 // Drives `steps` on `body`. Throws std::invalid_argument for a link without a base, clock or

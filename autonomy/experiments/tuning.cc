@@ -81,6 +81,7 @@ const std::map<std::string, std::string>& TunableParams() {
        "0: approach_margin only"},
       {"check_spacing", "m of path between quick looks while driving (0: none)"},
       {"correction_frames", "frames of a quick look"},
+      {"steer", "1: frames while driving re-aim a path leg under way from the estimate; 0: never"},
       {"moving_frames", "s between frames taken while driving straight (0: frames only at stops)"},
       {"arrival_fixes", "look-and-correct rounds on arrival"},
       {"arrival_slack", "error after an arrival's look left to the next action's own aim, m"},
@@ -140,6 +141,8 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->check_spacing_m = ToDouble(name, value);
   } else if (name == "moving_frames") {
     setup->moving_frame_period_s = ToDouble(name, value);
+  } else if (name == "steer") {
+    setup->steer_on_estimate = ToFlag(name, value);
   } else if (name == "correction_frames") {
     setup->correction_frames = ToInt(name, value);
   } else if (name == "arrival_fixes") {

@@ -293,7 +293,8 @@ void MatchWorld::KeepView(const platform::RgbdFrame& frame, const mapping::Objec
   camera_view_ = std::make_shared<const CameraView>(MakeCameraView(frame, objects, now_s()));
 }
 
-bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
+bool MatchWorld::Drive(const std::vector<DriveStep>& steps,
+                       const std::optional<Eigen::Vector2d>& leg_end, bool reverse) {
   platform::DriveBodyLink body = DriveLinkFor(*io_, robot_);
   // Turns closed on the gyro (opt-in): a robot file with an inertial sensor, gyro-aided.
   if (setup_.gyro_turns && setup_.gyro && robot_.imu) {
@@ -312,6 +313,7 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
   // The readings of the last camera latency (and one before), to pair a frame with, from the
   // drive's start on.
   std::deque<OdometryReading> recent;
+  std::optional<platform::DriveCorrection> correction;  // from the last frame, not yet applied
   if (look_moving && robot_.camera.latency_s > 0.0) {
     recent.push_back({now_s(), last_odometry, setup_.gyro ? io_->GyroHeadingRad() : std::nullopt});
   }
@@ -335,7 +337,22 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps) {
     if (!moved || turned_deg > setup_.moving_frame_max_turn_dps * dt) return;
     if (now_s() + 1e-9 < last_frame_s + frame_period_s) return;
     if (now_s() >= deadline_s_) return;
-    if (ObserveMoving(recent)) last_frame_s = now_s();  // none: the next period tries again
+    if (!ObserveMoving(recent)) return;  // none: the next period tries again
+    last_frame_s = now_s();
+    if (!leg_end || !setup_.steer_on_estimate) return;
+    const Eigen::Vector3d est = slam_.pose();
+    const Eigen::Vector2d d = *leg_end - est.head<2>();
+    const double sign = reverse ? -1.0 : 1.0;
+    const double change = platform::WrapAngleRad(std::atan2(sign * d.y(), sign * d.x()) - est.z());
+    const double remaining = d.norm() * std::cos(change);
+    if (std::abs(change) > setup_.steer_max_deg * kPi / 180.0) return;
+    if (remaining < setup_.steer_min_remaining_m) return;
+    correction = platform::DriveCorrection{change, remaining / odometry_scale_};
+  };
+  body.correct = [&correction]() {
+    std::optional<platform::DriveCorrection> c = correction;
+    correction.reset();
+    return c;
   };
   const int moving_before = moving_frames_;
   const Eigen::Vector3d start = slam_.pose();
@@ -629,9 +646,10 @@ bool MatchWorld::Navigate(const Eigen::Vector3d& target, double stop_spacing_m, 
         std::vector<DriveStep> steps;
         if (std::abs(again) > 2.0 * kPi / 180.0) steps.push_back(Turn(again * 180.0 / kPi));
         steps.push_back(Forward(sign * d.norm() / odometry_scale_));
-        Drive(steps);
+        Drive(steps, waypoints[i], reverse);
       } else {
-        Drive({Turn(turn * 180.0 / kPi), Forward(sign * d.norm() / odometry_scale_)});
+        Drive({Turn(turn * 180.0 / kPi), Forward(sign * d.norm() / odometry_scale_)}, waypoints[i],
+              reverse);
       }
     }
     if (replan) continue;

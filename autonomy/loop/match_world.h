@@ -90,6 +90,12 @@ struct MatchSetup {
   // processing run inside the drive controller's period, whose motor command stands meanwhile.
   double moving_frame_period_s = 0.0;
   double moving_frame_max_turn_dps = 20.0;
+  // Each frame while driving re-aims the path leg under way from SLAM-O's estimate: heading
+  // and distance to the leg's end (corrections up to steer_max_deg; none in the leg's last
+  // steer_min_remaining_m).
+  bool steer_on_estimate = false;
+  double steer_max_deg = 20.0;
+  double steer_min_remaining_m = 0.1;
 };
 
 // What the camera saw on the last frame whose objects were detected (the first and the last
@@ -224,7 +230,11 @@ class MatchWorld {
   void set_action_label(const std::string& label) { action_label_ = label; }
 
  private:
-  bool Drive(const std::vector<platform::DriveStep>& steps);
+  // With `leg_end` (a path leg's end, driven backwards when `reverse`) and frames while
+  // driving, each such frame steers the leg's straight drive from SLAM-O's estimate
+  // (MatchSetup::steer_on_estimate).
+  bool Drive(const std::vector<platform::DriveStep>& steps,
+             const std::optional<Eigen::Vector2d>& leg_end = std::nullopt, bool reverse = false);
   void Wait(double seconds);
   void Advance(double dt_s);
   // The encoders' (and gyro's) motion since the last prediction into SLAM-O: up to now, or up
