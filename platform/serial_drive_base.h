@@ -5,10 +5,11 @@
 // link and reopens the port after the device went away.
 //
 // Link loss: no valid frame from the board for link_timeout_s, or the port reporting a
-// hang-up. The host then sends STOP (which may not arrive: the board's own 50 ms watchdog is
-// what guarantees the stop), forgets the current command (after a reconnection the drive
-// stays stopped until the next SetSpeedTargets / SetPwm), and, if the port closed, tries to
-// reopen it every reconnect_period_s. A port that stays open but silent for
+// hang-up. The host then sends STOP and makes it its current command, re-sent every
+// stop_refresh_s while the link is down (the board's own 50 ms watchdog stops the motors only
+// when the host falls silent, and the heartbeats go on; after a reconnection the drive stays
+// stopped until the next SetSpeedTargets / SetPwm), and, if the port closed, tries to reopen
+// it every reconnect_period_s. A port that stays open but silent for
 // reopen_after_silence_s is closed and reopened too (a replugged board behind the same path).
 //
 // Encoder counts continue across a reconnection: the first frame after a link loss rebases
