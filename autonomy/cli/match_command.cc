@@ -54,6 +54,7 @@ struct MatchArgs {
   bool loop = false;
   double odometry_scale = 1.0;
   double speed_mps = 0.0;
+  double moving_frames_s = 0.0;  // frames while driving: off on the robot until tried there
   // Fault injection on the fake board's link.
   double drop = 0.0, garbage = 0.0, duplicate = 0.0;
   double unplug_at_s = -1.0, replug_at_s = -1.0;
@@ -71,6 +72,12 @@ int Match(const MatchArgs& args) {
   setup.gyro = false;            // the board streams no gyro (platform/PROTOCOL.md)
   setup.placement_jitter_m = 0;  // the field as its file has it
   setup.start_index = args.start_index;
+  // Frames while driving (and the legs steered from them) are the simulator's default, but
+  // here they are opt-in: the camera's Grab may wait for its next frame, and the frame's
+  // processing runs inside the drive controller's period with no heartbeat to the board (its
+  // watchdog stops the motors after 50 ms). Not yet tried on a robot.
+  setup.moving_frame_period_s = args.moving_frames_s;
+  setup.steer_on_estimate = args.moving_frames_s > 0.0;
   try {
     mapping::ParseFrameRule(args.frames, &setup.frames);
     strategy::MakeStrategy(args.strategy, setup.strategy_options);
@@ -223,6 +230,11 @@ void RegisterMatchCommand(CLI::App& app, CommandAction* action) {
                   "folder, for `slamo dry-run --from-recording`");
   cmd->add_flag("!--no-video", args->video, "skip replay.avi");
   cmd->add_flag("--quiet", args->quiet, "no line per action");
+  cmd->add_option("--moving-frames", args->moving_frames_s,
+                  "s between frames taken while driving, legs steered from them (0: frames "
+                  "only at stops; not yet tried on a robot)")
+      ->check(CLI::Range(0.0, 5.0))
+      ->capture_default_str();
   cmd->callback([args, action]() { *action = [args]() { return Match(*args); }; });
 }
 

@@ -79,7 +79,9 @@ const std::map<std::string, std::string>& TunableParams() {
       {"pick_in_view",
        "1: stage picks where the camera sees the target whole and skip it when the look misses it; "
        "0: approach_margin only"},
-      {"check_spacing", "m of path between quick looks while driving (0: none)"},
+      {"check_spacing",
+       "m of path between quick looks while driving (0: none; default 2.4 with steer and "
+       "moving_frames, 1.2 without)"},
       {"correction_frames", "frames of a quick look"},
       {"steer", "1: frames while driving re-aim a path leg under way from the estimate; 0: never"},
       {"moving_frames", "s between frames taken while driving straight (0: frames only at stops)"},

@@ -150,21 +150,27 @@ bool HardwareIo::MotorsDriven() const {
 std::optional<platform::RgbdFrame> HardwareIo::Capture() {
   const double give_up_s = base_clock_.NowS() + options_.frame_wait_s;
   while (true) {
-    std::optional<platform::RgbdFrame> frame = camera_->Grab();
-    if (frame) {
-      ++frames_;
-      if (options_.recorder && started_ && match_clock_.NowS() > last_frame_s_ + 1e-6) {
-        platform::RgbdFrame stamped = *frame;
-        stamped.t_s = last_frame_s_ = match_clock_.NowS();
-        options_.recorder->AddFrame(stamped);
-      }
-      return frame;
-    }
+    if (std::optional<platform::RgbdFrame> frame = GrabOnce()) return frame;
     if (base_clock_.NowS() >= give_up_s) break;
     Advance(0.005);
   }
   ++frames_missed_;
   return std::nullopt;
+}
+
+// None ready is not a miss: the drive goes on, and the next period asks again.
+std::optional<platform::RgbdFrame> HardwareIo::CaptureReady() { return GrabOnce(); }
+
+std::optional<platform::RgbdFrame> HardwareIo::GrabOnce() {
+  std::optional<platform::RgbdFrame> frame = camera_->Grab();
+  if (!frame) return std::nullopt;
+  ++frames_;
+  if (options_.recorder && started_ && match_clock_.NowS() > last_frame_s_ + 1e-6) {
+    platform::RgbdFrame stamped = *frame;
+    stamped.t_s = last_frame_s_ = match_clock_.NowS();
+    options_.recorder->AddFrame(stamped);
+  }
+  return frame;
 }
 
 std::optional<IntakeItem> HardwareIo::Pick(const strategy::ObjectBelief& target) {

@@ -120,6 +120,7 @@ class HardwareIo : public RobotIo {
   bool MotorsDriven() const override;
   std::optional<double> GyroHeadingRad() override { return std::nullopt; }
   std::optional<platform::RgbdFrame> Capture() override;
+  std::optional<platform::RgbdFrame> CaptureReady() override;
   std::optional<IntakeItem> Pick(const strategy::ObjectBelief& target) override;
   std::optional<ReleaseOutcome> Release(int intended_goal) override;
   std::optional<IntakeItem> Preload() const override { return preload_; }
@@ -143,6 +144,9 @@ class HardwareIo : public RobotIo {
     const platform::Clock& base_;
     double origin_s_ = 0.0;
   };
+
+  // The camera's frame if it has one now (counted, and recorded when recording).
+  std::optional<platform::RgbdFrame> GrabOnce();
 
   platform::SerialDriveBase* board_;
   platform::RgbdCamera* camera_;

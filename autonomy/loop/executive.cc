@@ -169,12 +169,15 @@ const std::vector<std::string>& KnockOutcomes() {
 
 namespace {
 
-// The thesis baseline is the thesis's rule: a fixed count of frames at every stop.
+// The thesis baseline is the thesis's rule: a fixed count of frames at every stop, and
+// frames only at stops.
 MatchSetup SetupFor(const strategy::Strategy& strategy, const MatchSetup& setup) {
   MatchSetup out = setup;
   if (strategy.name() == "thesis") {
     out.frames.rule = mapping::FrameRule::kFixed;
     out.frames.fixed_frames = setup.strategy_options.thesis_frames;
+    out.moving_frame_period_s = 0.0;
+    out.steer_on_estimate = false;
   }
   return out;
 }

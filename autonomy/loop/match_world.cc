@@ -132,6 +132,10 @@ mapping::SlamO SurveyedSlam(const field::SeasonConfig& field, const field::Robot
   return mapping::SlamO(field, robot.camera, prior, options);
 }
 
+double DefaultCheckSpacing(const MatchSetup& setup) {
+  return setup.moving_frame_period_s > 0.0 && setup.steer_on_estimate ? 2.4 : 1.2;
+}
+
 MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& season,
                        const field::RobotConfig& robot, const MatchSetup& setup, uint64_t seed,
                        bool perceive)
@@ -145,6 +149,7 @@ MatchWorld::MatchWorld(std::unique_ptr<RobotIo> io, const field::SeasonConfig& s
                          platform::StartPose(field_, setup.alliance, setup.start_index), true,
                          setup.adaptive_filter)),
       travel_(robot_.drive) {
+  if (setup_.check_spacing_m < 0.0) setup_.check_spacing_m = DefaultCheckSpacing(setup_);
   const Pose2D start_pose = platform::StartPose(field_, setup.alliance, setup.start_index);
   io_->Start(field_, robot_, start_pose);
   markers_ = platform::SurveyedMarkers(field_);
@@ -400,7 +405,7 @@ void MatchWorld::PredictTo(const Pose2D& odometry, const std::optional<double>& 
 }
 
 bool MatchWorld::ObserveMoving(const std::deque<OdometryReading>& recent) {
-  std::optional<platform::RgbdFrame> captured = io_->Capture();
+  std::optional<platform::RgbdFrame> captured = io_->CaptureReady();
   if (!captured) return false;
   // The frame shows the robot camera.latency_s ago: the filter is moved to that instant by
   // the readings about it (interpolated), updated, and moved on to now.

@@ -58,10 +58,11 @@ struct MatchSetup {
   double snapshot_period_s = 0.25;  // match time between replay snapshots (0: none)
   double drive_speed_mps = 0.0;     // 0: the robot's drive.match_speed_mps
   // How the executive drives with SLAM-O (perceiving strategies): a quick look of
-  // correction_frames every check_spacing_m of path (0: none); on arrival up to arrival_fixes
-  // rounds of look-and-correct until within arrival_tolerance_m; objects narrower than
-  // pushable_fraction of the robot's width are pushed aside, not planned round.
-  double check_spacing_m = 1.2;
+  // correction_frames every check_spacing_m of path (0: none; negative: DefaultCheckSpacing);
+  // on arrival up to arrival_fixes rounds of look-and-correct until within
+  // arrival_tolerance_m; objects narrower than pushable_fraction of the robot's width are
+  // pushed aside, not planned round.
+  double check_spacing_m = -1.0;
   int correction_frames = 5;
   int arrival_fixes = 2;
   double arrival_tolerance_m = 0.04;
@@ -85,18 +86,24 @@ struct MatchSetup {
   // Frames taken while driving past objects (#15 item 5), one every moving_frame_period_s of a
   // straight drive (0: only at stops), each its own stop of one frame, when the body turned by
   // at most moving_frame_max_turn_dps over the last control period (a frame taken mid-turn
-  // smears, and the heading the update pairs it at moves fastest then). Tried in the simulator
-  // only: on the robot the capture (up to HardwareIoOptions::frame_wait_s) and the frame's
-  // processing run inside the drive controller's period, whose motor command stands meanwhile.
-  double moving_frame_period_s = 0.0;
+  // smears, and the heading the update pairs it at moves fastest then). On the robot such a
+  // frame is taken only when the camera has one ready (RobotIo::CaptureReady): its processing
+  // (the detector's 4-11 ms, README) runs inside the drive controller's period, whose motor
+  // command stands meanwhile. Not yet tried on a robot.
+  double moving_frame_period_s = 0.2;
   double moving_frame_max_turn_dps = 20.0;
   // Each frame while driving re-aims the path leg under way from SLAM-O's estimate: heading
   // and distance to the leg's end (corrections up to steer_max_deg; none in the leg's last
   // steer_min_remaining_m).
-  bool steer_on_estimate = false;
+  bool steer_on_estimate = true;
   double steer_max_deg = 20.0;
   double steer_min_remaining_m = 0.1;
 };
+
+// The quick looks' spacing for `setup` when it leaves it to the executive: 2.4 m of path when
+// legs are steered from frames while driving, 1.2 m otherwise (each the better of the two for
+// its case: README, #15, "Then: steering a leg from the estimate").
+double DefaultCheckSpacing(const MatchSetup& setup);
 
 // What the camera saw on the last frame whose objects were detected (the first and the last
 // frame of every look), downscaled, with those detections: the replay's camera panel. One is

@@ -72,6 +72,10 @@ class RobotIo {
   virtual std::optional<double> GyroHeadingRad() = 0;
   // The camera's frame now; nothing when the camera has none.
   virtual std::optional<platform::RgbdFrame> Capture() = 0;
+  // A frame only if the camera has one ready, never waiting for it: frames taken while
+  // driving, where the drive controller must get its period back (the simulator renders one
+  // at once).
+  virtual std::optional<platform::RgbdFrame> CaptureReady() { return Capture(); }
   // The intake, in front of `target`; nothing when it took nothing.
   virtual std::optional<IntakeItem> Pick(const strategy::ObjectBelief& target) = 0;
   // The release, aimed at goal `intended_goal` (-1: dropped on the floor); nothing when

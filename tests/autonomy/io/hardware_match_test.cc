@@ -62,17 +62,24 @@ field::SeasonConfig ShortSeason() {
   return season;
 }
 
+// As `slamo match` sets it up: no gyro, the field as its file has it, frames only at stops.
 MatchSetup HardwareSetup() {
   MatchSetup setup;
   setup.gyro = false;  // the board streams no gyro
   setup.placement_jitter_m = 0.0;
+  setup.moving_frame_period_s = 0.0;
+  setup.steer_on_estimate = false;
   return setup;
 }
 
 TEST(HardwareMatch, ClosesTheLoopOverTheFakeBoardsSerialLink) {
   const field::SeasonConfig season = ShortSeason();
   const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
-  const MatchSetup setup = HardwareSetup();
+  MatchSetup setup = HardwareSetup();
+  // With frames while driving (`slamo match --moving-frames 0.2`), taken only when the camera
+  // has one ready.
+  setup.moving_frame_period_s = 0.2;
+  setup.steer_on_estimate = true;
   Bench bench(robot);
   const platform::Pose2D start = platform::StartPose(season, setup.alliance, 0);
   FakeBoardCamera camera(season, robot, bench.board.board(), start, bench.clock, 1);
@@ -95,6 +102,7 @@ TEST(HardwareMatch, ClosesTheLoopOverTheFakeBoardsSerialLink) {
   // seeing the field from there, kept up with it.
   EXPECT_FALSE(r.truth_known);
   EXPECT_GT(r.frames_taken, 10);
+  EXPECT_GT(r.moving_frames, 0);
   ASSERT_FALSE(std::isnan(r.pose_ate_m));
   EXPECT_LT(r.pose_ate_m, 0.15);
   // (How far it went, not where it ended: on this seed it drives 0.46 m towards the middle
@@ -111,6 +119,35 @@ TEST(HardwareMatch, ClosesTheLoopOverTheFakeBoardsSerialLink) {
   EXPECT_EQ(r.board.at("link_losses"), 0.0);
   EXPECT_EQ(r.board.at("board_errors"), 0.0);
   EXPECT_GT(r.board.at("encoder_frames"), 500.0);
+}
+
+// A camera with nothing to give.
+class SilentCamera : public platform::RgbdCamera {
+ public:
+  std::optional<platform::RgbdFrame> Grab() override {
+    ++grabs;
+    return std::nullopt;
+  }
+  int grabs = 0;
+};
+
+// A frame while driving is taken only if the camera has one ready: the drive controller gets
+// its period back. A look at a stop waits up to frame_wait_s for one.
+TEST(HardwareMatch, AFrameWhileDrivingNeverWaitsForTheCamera) {
+  const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+  Bench bench(robot);
+  SilentCamera camera;
+  HardwareIoOptions options;
+  options.frame_wait_s = 0.1;
+  HardwareIo io(
+      &bench.link, &camera, bench.clock, [&](double dt) { bench.Pace(dt); }, options);
+  const double t0 = bench.clock.NowS();
+  EXPECT_FALSE(io.CaptureReady());
+  EXPECT_EQ(bench.clock.NowS(), t0);
+  EXPECT_EQ(camera.grabs, 1);
+  EXPECT_FALSE(io.Capture());
+  EXPECT_GE(bench.clock.NowS() - t0, options.frame_wait_s);
+  EXPECT_GT(camera.grabs, 10);
 }
 
 TEST(HardwareMatch, SurvivesAnUnpluggedCableAndANoisyLink) {
