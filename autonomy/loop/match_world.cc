@@ -349,6 +349,10 @@ bool MatchWorld::Drive(const std::vector<DriveStep>& steps,
     const Eigen::Vector2d d = *leg_end - est.head<2>();
     const double sign = reverse ? -1.0 : 1.0;
     const double change = platform::WrapAngleRad(std::atan2(sign * d.y(), sign * d.x()) - est.z());
+    // What is left along the heading driven so far: re-aimed, the drive stops short of the leg
+    // end by d (1 - cos(change)) (at most 6 %, at 20 degrees), for the next frame or the
+    // arrival to finish. Driving all of d instead measured worse (200 seeds, paired: Over
+    // Under disturbed -0.175 +- 0.130, 4 seeds better, 15 worse; the rest within +-0.04).
     const double remaining = d.norm() * std::cos(change);
     if (std::abs(change) > setup_.steer_max_deg * kPi / 180.0) return;
     if (remaining < setup_.steer_min_remaining_m) return;
