@@ -631,6 +631,9 @@ TEST(Executive, WithPickInViewAPickWhoseTargetIsGoneIsSkipped) {
 // coast out after a drive). Now 6 of 200 nominal seeds score 3 more with the charge (37, 73,
 // 78, 134, 135, 179), none less: `slamo tune --season push_back --robot v5_drivetrain
 // --matches 200 --param strategy=planner --param look_charge=0,1`, 5.85 -> 5.94.
+// Since frames while driving and steered legs became the defaults the charge changes no
+// match of seeds 1-120 (5.97 either way; not traced further). The test keeps the driving of
+// its seed.
 TEST(Executive, ALookBeforeACycleIsChargedItsTime) {
   const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
@@ -696,12 +699,14 @@ TEST(Executive, APickOrReleaseLooksOnlyWhenTheSceneChangedSinceTheLastLook) {
   EXPECT_GT(frames_of(strategy::ActionKind::kPick, Before::kDrop), 0);
 }
 
-// Over Under seed 22 with the V5 robot: after its preload the planner sets off to push a far
+// Over Under seed 36 with the V5 robot: after its preload the planner sets off to push a far
 // green triball, and the drive carries a green triball lying in our offensive zone out of it
 // (2 points lost). Charged for that loss, the sequence is not worth it. (Over seeds 1-30
-// nominal, `--param push_loss=0,1`: 4.73 -> 5.33 gained, no seed worse, at e453a17; then seed
-// 14 showed it, which later timing changes turned away from the push on their own, then seed
-// 6, which pushes under the goals' bars turned to another push that loses nothing.)
+// nominal, `--param push_loss=0,1`: 4.73 -> 5.33 gained, no seed worse, at e453a17; then seeds
+// 14, 6 and 22 showed it, each until timing changes turned the planner away from the push on
+// their own; seed 36 since frames while driving and steered legs became the defaults, found
+// with `slamo tune --season over_under --robot v5_drivetrain --matches 60 --param
+// strategy=planner --param push_loss=0,1`: 8.02 -> 8.25, 6 seeds better, 2 worse.)
 // Points the planner gains on `season` with the V5 robot, seed `seed`, with the push-loss rules
 // on or off (StrategyOptions::count_push_loss); no overrun either way.
 int GainedWithPushLoss(const std::string& season_name, uint64_t seed, bool count) {
@@ -710,7 +715,6 @@ int GainedWithPushLoss(const std::string& season_name, uint64_t seed, bool count
   MatchSetup setup;
   setup.strategy = "planner";
   setup.strategy_options.count_push_loss = count;
-  DriveAsWhenSeedsWereChosen(&setup);
   const MatchResult r = RunMatch(season, robot, setup, seed);
   EXPECT_EQ(r.overrun_s, 0.0);
   return r.points - r.points_start;
@@ -718,8 +722,8 @@ int GainedWithPushLoss(const std::string& season_name, uint64_t seed, bool count
 
 TEST(Executive, ADriveThatWouldPushOurTriballOutOfItsZoneIsNotTaken) {
   // The preload's 5, less the triball pushed out; then the preload's 5.
-  EXPECT_EQ(GainedWithPushLoss("over_under", 22, false), 3);
-  EXPECT_EQ(GainedWithPushLoss("over_under", 22, true), 5);
+  EXPECT_EQ(GainedWithPushLoss("over_under", 36, false), 3);
+  EXPECT_EQ(GainedWithPushLoss("over_under", 36, true), 5);
 }
 
 // The second cycle of a sequence is not planned on objects the first one's drive pushes on.
