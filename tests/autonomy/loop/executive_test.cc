@@ -542,7 +542,11 @@ TEST(Executive, ALegShorterThanTheArrivalToleranceIsNotTurnedFor) {
 // disturbed seed 3 the planner's drive to the red goal ended 6 cm off its stage, and the
 // correction (a turn to back up, the drive, the turn back) cost 1.6 s before the release,
 // which aims at the goal from the estimate anyway. (Over Under disturbed, 200 seeds: +0.28
-// points a match; nominal, Push Back, Toss Up and High Stakes within their noise.)
+// points a match; nominal, Push Back, Toss Up and High Stakes within their noise.) Seed 3 shows
+// it with the old driving only; with today's (frames while driving, steered legs) seed 20 does:
+// the first drive takes 7.38 s with only the 4 cm tolerance accepted, 5.96 s by default, the
+// same points (`slamo dry-run --season over_under --robot v5_drivetrain --scenario disturbed
+// --seed 20 [--param arrival_slack=0]`; seeds 2, 21 and 31 of 1-40 save more than 1 s too).
 TEST(Executive, AnArrivalErrorTheNextActionAbsorbsIsNotDrivenOff) {
   const field::SeasonConfig season = field::LoadSeasonConfig("over_under");
   const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
@@ -551,8 +555,7 @@ TEST(Executive, AnArrivalErrorTheNextActionAbsorbsIsNotDrivenOff) {
     setup.strategy = "planner";
     setup.scenario = Scenario::kDisturbed;
     setup.arrival_slack_m = slack_m;
-    DriveAsWhenSeedsWereChosen(&setup);
-    const MatchResult r = RunMatch(season, robot, setup, 3);
+    const MatchResult r = RunMatch(season, robot, setup, 20);
     EXPECT_EQ(r.overrun_s, 0.0);
     for (const TimelineEntry& e : r.timeline) {
       if (e.action == "NAVIGATE") return std::make_pair(e.end_s - e.t_s, r);
