@@ -231,8 +231,9 @@ void RegisterMatchCommand(CLI::App& app, CommandAction* action) {
   cmd->add_flag("!--no-video", args->video, "skip replay.avi");
   cmd->add_flag("--quiet", args->quiet, "no line per action");
   cmd->add_option("--moving-frames", args->moving_frames_s,
-                  "s between frames taken while driving, legs steered from them (0: frames "
-                  "only at stops; not yet tried on a robot)")
+                  "s between frames taken while driving, legs steered from them and a quick "
+                  "look every 2.4 m of path instead of 1.2 (0: frames only at stops; not yet "
+                  "tried on a robot)")
       ->check(CLI::Range(0.0, 5.0))
       ->capture_default_str();
   cmd->callback([args, action]() { *action = [args]() { return Match(*args); }; });

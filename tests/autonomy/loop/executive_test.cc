@@ -450,10 +450,11 @@ TEST(Executive, TheV5RobotReentersALongGoalAlongItsAxisAndBacksUpShortLegs) {
   EXPECT_LT(drive_back(backwards), drive_back(forwards) - 0.5);
 }
 
-// The drive of the commits that chose the seeds below: frames only at stops, a quick look
-// every 1.2 m of path, legs held on the encoders. Frames while driving and steering from the
-// estimate became the defaults later (README, #15) and take these seeds other courses; the
-// tests keep the traces they were written on, each showing its own mechanism.
+// The drive of the commits that chose the seeds of the tests that call this: frames only at
+// stops, a quick look every 1.2 m of path, legs held on the encoders. Frames while driving and
+// steering from the estimate became the defaults later (README, #15) and take those seeds
+// other courses; the tests keep the traces they were written on, each showing its own
+// mechanism.
 void DriveAsWhenSeedsWereChosen(MatchSetup* setup) {
   setup->moving_frame_period_s = 0.0;
   setup->steer_on_estimate = false;
@@ -491,8 +492,8 @@ TEST(Executive, APushAlongTheFloorIsJudgedAndScores) {
   EXPECT_EQ(pushes, 1);
   EXPECT_EQ(scored, 1);
   for (const AttemptCheck& a : without.attempts) EXPECT_NE(a.action, "PUSH");
-  // The push's 2 points at least (measured: +2 before the tracker forgot the objects the
-  // robot's footprint met on its way, +4 since).
+  // The push's 2 points at least (measured on the old driving: +2 before the tracker forgot
+  // the objects the robot's footprint met on its way, +4 since; +2 on today's defaults).
   EXPECT_GE(with.points - with.points_start, without.points - without.points_start + 2);
   EXPECT_EQ(with.overrun_s, 0.0);
 }
@@ -544,7 +545,7 @@ TEST(Executive, ALegShorterThanTheArrivalToleranceIsNotTurnedFor) {
 // which aims at the goal from the estimate anyway. (Over Under disturbed, 200 seeds: +0.28
 // points a match; nominal, Push Back, Toss Up and High Stakes within their noise.) Seed 3 shows
 // it with the old driving only; with today's (frames while driving, steered legs) seed 20 does:
-// the first drive takes 7.38 s with only the 4 cm tolerance accepted, 5.96 s by default, the
+// the first drive takes 7.38 s with only the 4 cm tolerance accepted, 5.95 s by default, the
 // same points (`slamo dry-run --season over_under --robot v5_drivetrain --scenario disturbed
 // --seed 20 [--param arrival_slack=0]`; seeds 2, 21 and 31 of 1-40 save more than 1 s too).
 TEST(Executive, AnArrivalErrorTheNextActionAbsorbsIsNotDrivenOff) {
