@@ -329,7 +329,7 @@ TEST(Executive, TheDisturbedLayoutMovesEveryLooseFloorObjectThirtyToEightyCentim
       EXPECT_GT(floor, 0) << name;
       EXPECT_GE(moved, floor * 9 / 10) << name << " seed " << seed;
       if (name == "push_back") {
-        EXPECT_EQ(held_objects, 4 * 12) << "four loaders of 12";
+        EXPECT_EQ(held_objects, 4 * 6) << "four loaders of 6";
       }
     }
   }
