@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -272,6 +273,54 @@ double StandingHeightM(const cv::Mat& piece_mask, cv::Point offset, const cv::Ma
   const double low = heights[cut];
   std::nth_element(heights.begin(), heights.end() - 1 - cut, heights.end());
   return heights[heights.size() - 1 - cut] - low;
+}
+
+// DetectOptions::depth_cut_min_m: clears, in `mask`, the farther pixel of every pair of
+// 8-connected neighbours of it whose depths differ by more than the cut (pixels without a
+// reading are left: a line of them still joins what it runs between). Returns how many
+// clearings were made (a pixel may be counted more than once): 0 when nothing was cut.
+int CutAtDepthEdges(const cv::Mat& depth_mm, const CameraModel& camera,
+                    const DetectOptions& options, cv::Mat* mask) {
+  thread_local std::vector<cv::Point> cleared;
+  cleared.clear();
+  const int rows = mask->rows, cols = mask->cols;
+  // The depth correction is linear in the raw reading (CameraModel::CorrectDepthM).
+  const double offset = camera.CorrectDepthM(0.0);
+  const double scale = camera.CorrectDepthM(1.0) - offset;
+  const auto jumps = [&](uint16_t raw_a, uint16_t raw_b) {
+    const double a = offset + scale * raw_a, b = offset + scale * raw_b;
+    const double near = std::min(a, b), step = std::abs(a - b);
+    return step > options.depth_cut_min_m && step > options.depth_cut_ratio * near &&
+           step > options.depth_cut_sigmas * camera.DepthSigmaM(near);
+  };
+  const auto farther = [&](uint16_t raw_a, uint16_t raw_b) {
+    return (offset + scale * raw_a) > (offset + scale * raw_b);
+  };
+  for (int v = 0; v < rows; ++v) {
+    const uint8_t* m = mask->ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    const bool last = v + 1 == rows;
+    const uint8_t* m_next = last ? nullptr : mask->ptr<uint8_t>(v + 1);
+    const uint16_t* d_next = last ? nullptr : depth_mm.ptr<uint16_t>(v + 1);
+    for (int u = 0; u < cols; ++u) {
+      // Most of a colour's mask is empty: skip it eight bytes at a time.
+      uint64_t eight;
+      while (u + 8 <= cols && (std::memcpy(&eight, m + u, 8), eight == 0)) u += 8;
+      if (u >= cols) break;
+      if (!m[u] || !d[u]) continue;
+      const auto look = [&](int x, int y, uint16_t other) {
+        if (other && jumps(d[u], other))
+          cleared.push_back(farther(d[u], other) ? cv::Point(u, v) : cv::Point(x, y));
+      };
+      if (u + 1 < cols && m[u + 1]) look(u + 1, v, d[u + 1]);
+      if (last) continue;
+      for (int x = std::max(0, u - 1); x <= std::min(cols - 1, u + 1); ++x) {
+        if (m_next[x]) look(x, v + 1, d_next[x]);
+      }
+    }
+  }
+  for (const cv::Point& p : cleared) mask->at<uint8_t>(p) = 0;
+  return static_cast<int>(cleared.size());
 }
 
 // How many times smaller the image K-Means clusters is (DetectOptions::kmeans_downsample).
@@ -710,7 +759,37 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
 
     std::vector<std::vector<cv::Point>> blobs;
-    FindOuterContours(masks[j], &blobs);  // leaves the mask as it is
+    // Cut at depth edges, a blob's region may hold another's (an object framed by the poster
+    // behind it): each 8-connected region is then outlined on its own, and a blob's filled
+    // outline leaves out the regions it holds (blob_label: the region of each blob found).
+    cv::Mat labels;
+    std::vector<int> blob_label;
+    if (have_depth && all_solid && options.depth_cut_min_m > 0.0) {
+      cv::Mat cut = masks[j].clone();
+      if (CutAtDepthEdges(depth_mm, *setup.camera, options, &cut) > 0) {
+        cv::Mat region_stats, centroids;
+        const int regions =
+            cv::connectedComponentsWithStats(cut, labels, region_stats, centroids, 8, CV_32S);
+        std::vector<std::vector<cv::Point>> outline;
+        for (int r = 1; r < regions; ++r) {
+          // A region smaller than any blob kept (a speck the cut left) is not outlined.
+          if (region_stats.at<int>(r, cv::CC_STAT_AREA) < options.min_area_px) {
+            ++st.rejected_small;
+            continue;
+          }
+          const cv::Rect roi(region_stats.at<int>(r, cv::CC_STAT_LEFT),
+                             region_stats.at<int>(r, cv::CC_STAT_TOP),
+                             region_stats.at<int>(r, cv::CC_STAT_WIDTH),
+                             region_stats.at<int>(r, cv::CC_STAT_HEIGHT));
+          FindOuterContours(labels(roi) == r, &outline, roi.tl());
+          for (std::vector<cv::Point>& o : outline) {
+            blobs.push_back(std::move(o));
+            blob_label.push_back(r);
+          }
+        }
+      }
+    }
+    if (labels.empty()) FindOuterContours(masks[j], &blobs);  // leaves the mask as it is
     // Blobs found in the mask; what is left of one after its floating part is cleared is
     // appended, and not tested again.
     const size_t found_blobs = blobs.size();
@@ -730,6 +809,15 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           (box + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
       cv::Mat blob_mask(window.size(), CV_8UC1, cv::Scalar(0));
       FillOutline(blob, -window.tl(), &blob_mask);
+      if (b < blob_label.size() && blob_label[b] > 0) {
+        for (int v = 0; v < window.height; ++v) {
+          const int* region = labels.ptr<int>(window.y + v) + window.x;
+          uint8_t* m = blob_mask.ptr<uint8_t>(v);
+          for (int u = 0; u < window.width; ++u) {
+            if (region[u] > 0 && region[u] != blob_label[b]) m[u] = 0;
+          }
+        }
+      }
       // The outline filled (after a split by size, eroded by a pixel, as it was measured
       // with), until a closing changes it.
       bool blob_mask_is_fill = true;
@@ -793,7 +881,16 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           ++st.rejected_floating;
           std::vector<std::vector<cv::Point>> rest;
           FindOuterContours(kept, &rest, window.tl());
-          for (std::vector<cv::Point>& r : rest) blobs.push_back(std::move(r));  // `blob` dangles
+          // What is left keeps the blob's region: its filled outline still leaves out the
+          // regions the blob holds.
+          const int region = b < blob_label.size() ? blob_label[b] : 0;
+          for (std::vector<cv::Point>& r : rest) {
+            blobs.push_back(std::move(r));  // `blob` dangles
+            if (region > 0) {
+              blob_label.resize(blobs.size() - 1, 0);
+              blob_label.push_back(region);
+            }
+          }
           continue;
         }
       }

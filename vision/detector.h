@@ -115,6 +115,15 @@ struct DetectOptions {
   int attach_min_columns = 3;
   int attach_above_rows = 2;     // rows over the top (after one skipped: mixed edge readings)
   double attach_floor_m = 0.03;  // over the top, a point this low is the floor
+  // With depth, for colours whose kinds are all solid: the colour mask is cut where the depth
+  // of two neighbouring pixels (8-connected) of it jumps by more than depth_cut_min_m,
+  // depth_cut_ratio x the nearer one's depth, and depth_cut_sigmas x its depth noise, all
+  // three; the farther pixel is cleared. An object seen against a thing of its own colour far
+  // behind it (a poster, a shirt, an alliance wall across the field) is then a blob of its
+  // own. Semi-transparent kinds are not cut: depth reads through them. 0: off.
+  double depth_cut_min_m = 0.25;
+  double depth_cut_ratio = 0.1;
+  double depth_cut_sigmas = 4.0;
   bool drop_floating = true;
   double float_margin_m = 0.02;
   int float_below_rows = 2;

@@ -1,6 +1,7 @@
 // Detection per frame, for each method, on a rendered Toss Up view with solid and
 // semi-transparent balls, at the depth camera's 512x424 and at 1920x1080 (the Kinect V2
-// colour resolution); and the threshold's masks alone, by either path. One core.
+// colour resolution); on a Push Back arena view, with and without the cut at depth edges;
+// and the threshold's masks alone, by either path. One core.
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -37,6 +38,36 @@ const Scene& SceneAt(int width) {
       renderer.Render(world, platform::Pose2D{-1.2, -0.5, 0.5}, 0.0, nullptr);
   Scene scene{frame.colour, frame.depth_mm, ObjectDetectorSetup(season, &robot.camera)};
   return scenes.emplace(width, std::move(scene)).first->second;
+}
+
+// A Push Back view in the arena (blocks: every kind solid, so the cut at depth edges runs), at
+// the depth camera's 512x424, looking across the field at the far alliance wall and the crowd.
+const Scene& ArenaScene() {
+  static const Scene scene = [] {
+    const field::SeasonConfig season = field::LoadSeasonConfig("push_back");
+    const field::RobotConfig robot = field::LoadRobotConfig("thesis_robot");
+    const platform::SimWorld world = platform::CreateWorld(season, 1);
+    platform::RenderOptions render;
+    render.arena = true;
+    platform::SimRenderer renderer(season, robot.camera, render, 1);
+    const platform::RgbdFrame frame =
+        renderer.Render(world, platform::Pose2D{-1.0, 0.9, 0.2}, 0.0, nullptr);
+    return Scene{frame.colour, frame.depth_mm, ObjectDetectorSetup(season, &robot.camera)};
+  }();
+  return scene;
+}
+
+void BM_DetectArena(benchmark::State& state, DetectMethod method, bool depth_cut) {
+  const Scene& scene = ArenaScene();
+  DetectOptions options;
+  options.method = method;
+  if (!depth_cut) options.depth_cut_min_m = 0.0;
+  size_t found = 0;
+  for (auto _ : state) {
+    found = Detect(scene.colour, scene.depth, scene.setup, options).size();
+    benchmark::DoNotOptimize(found);
+  }
+  state.SetLabel("push_back arena, " + std::to_string(found) + " found");
 }
 
 void BM_Detect(benchmark::State& state, DetectMethod method, SeparationMethod separation,
@@ -99,6 +130,16 @@ BENCHMARK_CAPTURE(BM_Detect, kmeans_defects, DetectMethod::kKMeans,
 BENCHMARK_CAPTURE(BM_Detect, kmeans_watershed, DetectMethod::kKMeans, SeparationMethod::kWatershed)
     ->Arg(512)
     ->Arg(1920)
+    ->Unit(benchmark::kMillisecond);
+// What the cut at depth edges costs (DetectOptions::depth_cut_min_m).
+BENCHMARK_CAPTURE(BM_DetectArena, threshold_defects, DetectMethod::kThreshold, true)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DetectArena, threshold_defects_without_depth_cut, DetectMethod::kThreshold,
+                  false)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DetectArena, kmeans_defects, DetectMethod::kKMeans, true)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DetectArena, kmeans_defects_without_depth_cut, DetectMethod::kKMeans, false)
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -265,13 +265,16 @@ TEST(VisionEvalTest, BumperPiecesUnderTheirChassisAreNotTakenForTriballs) {
 // (SizeSplitOptions::sliver_fraction): Skyrise's strips of touching cubes are found. Measured
 // with `slamo eval vision --season skyrise --arena --frames 20 --seed 1 [--no-sliver-drop]`:
 // recall +0.24 to +0.33 per method (kmeans+defects 0.697 -> 0.895), precision -0.014 to
-// +0.012; the test asks for +0.15 of recall and at most 0.03 of precision lost, per method.
+// +0.012. Since colour masks are cut at depth edges (DetectOptions::depth_cut_min_m), which
+// takes many cubes apart from what stands behind them, less is left for it: recall +0.048 to
+// +0.099 (kmeans+defects 0.876 -> 0.930), precision -0.025 to +0.001. The test asks for +0.04
+// of recall and at most 0.03 of precision lost, per method.
 TEST(VisionEvalTest, ASliverDoesNotRefuseAPileOfCubes) {
   VisionEvalOptions without;
   without.detect.size_split.sliver_fraction = 0.0;
   CompareInArena("skyrise", 20, {}, without,
                  [](const VisionMethodScore& a, const VisionMethodScore& b) {
-                   EXPECT_GT(a.Recall(), b.Recall() + 0.15);
+                   EXPECT_GT(a.Recall(), b.Recall() + 0.04);
                    EXPECT_GT(a.Precision(), b.Precision() - 0.03);
                  });
 }
@@ -318,17 +321,19 @@ TEST(VisionEvalTest, UprightBarsAreNotTakenForRings) {
 // second detection on one object or one spanning two. Measured on these 20 Skyrise arena
 // views: false detections on pieces of objects 187 -> 154 over the six methods (199 -> 142
 // when the split by size still shrank the blob it was given, and the pieces grew over less),
-// precision up for each method, the same objects found; the test asks for a seventh fewer,
-// precision up and the same objects found, per method.
+// precision up for each method, the same objects found. Since colour masks are cut at depth
+// edges (DetectOptions::depth_cut_min_m): 139 -> 109, precision up for each method, the same
+// objects found by the threshold and one more by each K-Means method. The test asks for a
+// seventh fewer, precision up and no object lost, per method.
 TEST(VisionEvalTest, PiecesSplitBySizeDoNotOverlap) {
   VisionEvalOptions without;
   without.detect.size_split.exclusive_growth = false;
   const ArenaComparison r = CompareInArena(
       "skyrise", 20, {}, without, [](const VisionMethodScore& a, const VisionMethodScore& b) {
         EXPECT_GT(a.Precision(), b.Precision());
-        EXPECT_EQ(a.found, b.found);
+        EXPECT_GE(a.found, b.found);
       });
-  EXPECT_GT(r.on_pieces_without, 150);
+  EXPECT_GT(r.on_pieces_without, 120);
   EXPECT_LT(7 * r.on_pieces, 6 * r.on_pieces_without);
 }
 
@@ -359,8 +364,11 @@ TEST(VisionEvalTest, PilesAreCountedWithTheSplitBySize) {
 // Measured with this test's own figures (20 arena views, seed 1), one part -> parts:
 // threshold+defects precision 0.751 -> 0.805, recall 0.812 -> 0.818, groups counted right
 // 25 -> 31 of 50; kmeans+defects 0.684 -> 0.753, 0.803 -> 0.822, 19 -> 29 of 50 (0.672 ->
-// 0.718 and 0.616 -> 0.684 before floating bumpers were cleared). The test asks for +0.03
-// precision, no recall lost, and a tenth more of the groups.
+// 0.718 and 0.616 -> 0.684 before floating bumpers were cleared). Since colour masks are cut
+// at depth edges (DetectOptions::depth_cut_min_m), which parts some of those objects itself:
+// threshold+defects 0.853 -> 0.859, 0.943 -> 0.959, groups 32 -> 36 of 50; kmeans+defects
+// 0.826 -> 0.861, 0.930 -> 0.930, 32 -> 36. The test asks for precision up, no recall lost,
+// and three more groups counted right.
 TEST(VisionEvalTest, ObjectsApartOnTheFloorAreNotCutByTheSizeSplit) {
   VisionEvalOptions one_part;
   one_part.detect.size_split.link_fraction = 0.0;  // as before: a level is one part
@@ -369,10 +377,30 @@ TEST(VisionEvalTest, ObjectsApartOnTheFloorAreNotCutByTheSizeSplit) {
   ASSERT_EQ(parts.size(), whole.size());
   for (size_t k : {0, 3}) {
     SCOPED_TRACE(parts[k].name);
-    EXPECT_GT(parts[k].Precision(), whole[k].Precision() + 0.03);
+    EXPECT_GT(parts[k].Precision(), whole[k].Precision());
     EXPECT_GE(parts[k].Recall(), whole[k].Recall());
     ASSERT_GT(parts[k].groups, 20);
-    EXPECT_GT(parts[k].groups_counted, whole[k].groups_counted + parts[k].groups / 10);
+    EXPECT_GE(parts[k].groups_counted, whole[k].groups_counted + 3);
+  }
+}
+
+// Colour masks are cut where the depth jumps (DetectOptions::depth_cut_min_m): a block or a
+// cube seen against a poster, a shirt or an alliance wall of its colour far behind it is a
+// blob of its own instead of a part of that one. Measured on these 20 arena views, without ->
+// with the cut: Push Back recall +0.107 to +0.155 per method (kmeans+defects 0.660 -> 0.777),
+// precision +0.003 to +0.035; Skyrise recall +0.020 to +0.061 (0.892 -> 0.930), precision
+// +0.009 to +0.047, false detections on pieces of cubes 154 -> 109 over the six methods. The
+// test asks for precision up and +0.015 of recall, per method and season.
+TEST(VisionEvalTest, ObjectsBeforeThingsOfTheirColourAreFound) {
+  VisionEvalOptions without;
+  without.detect.depth_cut_min_m = 0.0;
+  for (const char* season : {"push_back", "skyrise"}) {
+    SCOPED_TRACE(season);
+    CompareInArena(season, 20, {}, without,
+                   [](const VisionMethodScore& a, const VisionMethodScore& b) {
+                     EXPECT_GT(a.Precision(), b.Precision());
+                     EXPECT_GT(a.Recall(), b.Recall() + 0.015);
+                   });
   }
 }
 
