@@ -506,6 +506,9 @@ std::optional<ObjectExtent> SizeExtentOf(const std::vector<TargetKind>& kinds,
     if (reach_m > widest_m) widest_m = reach_m, *kind = &k;
     extent.height_m = std::max(extent.height_m, 2.0 * k.centre_height_m);
     extent.max_stack = std::max(extent.max_stack, k.max_stack);
+    extent.rest_heights_m.insert(extent.rest_heights_m.end(), k.rest_heights_m.begin(),
+                                 k.rest_heights_m.end());
+    extent.rest_max_stack = std::max(extent.rest_max_stack, k.rest_max_stack);
   }
   extent.width_m = 2.0 * (*kind)->radius_m;
   extent.horizontal_limit = widest_m / extent.width_m;
@@ -653,7 +656,14 @@ DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
       k.solid = type.material != field::Material::kSemiTransparent;
       // The tallest stack of this type the season file places (High Stakes' corner rings).
       for (const field::ObjectPlacement& p : season.objects) {
-        if (p.type == type.name) k.max_stack = std::max(k.max_stack, p.stack_size);
+        if (p.type != type.name) continue;
+        k.max_stack = std::max(k.max_stack, p.stack_size);
+        if (p.z_m > 0.0 && p.stack_level == 0) {
+          k.rest_max_stack = std::max(k.rest_max_stack, p.stack_size);
+          if (std::find(k.rest_heights_m.begin(), k.rest_heights_m.end(), p.z_m) ==
+              k.rest_heights_m.end())
+            k.rest_heights_m.push_back(p.z_m);
+        }
       }
       k.centre_height_m = type.height_m / 2.0;
       setup.kinds.push_back(k);

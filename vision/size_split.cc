@@ -155,13 +155,32 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   for (size_t i = 0; i < points.size(); ++i) heights[i] = points[i][2];
   double bottom = 0.0;
   const double height_units = TrimmedExtent(&heights, options.trim_fraction, &bottom);
+  // Objects resting on something the season places them on (a goal's top) stand on it as on
+  // the floor: their heights are counted from it.
+  // (support: that height, in object heights; 0 on the floor.)
+  double support = 0.0;
+  if (options.rest_on_supports) {
+    for (const double h : extent.rest_heights_m) {
+      const double units = h / extent.height_m;
+      if (std::abs(bottom - units) < std::abs(bottom - support)) support = units;
+    }
+  }
+  if (support > 0.0 && std::abs(bottom - support) <= options.floor_tolerance) {
+    for (cv::Vec3f& q : points) q[2] -= static_cast<float>(support);
+    for (float& h : heights) h -= static_cast<float>(support);
+    bottom -= support;
+  } else {
+    support = 0.0;
+  }
+  // On a support, stacks no taller than the season places there.
+  const int max_stack = support > 0.0 ? extent.rest_max_stack : extent.max_stack;
   // Objects whose sides are hidden show just their top faces: a flat blob at a whole number of
   // object heights (the top check below), not a floor marking or a low bar.
   const bool top_faces = options.top_faces && height_units < extent.min_vertical &&
                          std::round(bottom) >= 1.0 &&
-                         std::round(bottom) <= std::max(1, extent.max_stack) &&
+                         std::round(bottom) <= std::max(1, max_stack) &&
                          std::abs(bottom - std::round(bottom)) <= options.top_tolerance;
-  if (height_units > extent.vertical_limit * std::max(1, extent.max_stack)) return result;
+  if (height_units > extent.vertical_limit * std::max(1, max_stack)) return result;
   // A blob whose lower edge is hidden (behind a low bar) may show only the upper part of its
   // objects: its bottom is not where they rest.
   const auto lower_edge_hidden = [&] {
@@ -341,6 +360,21 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
       // Cells are points at their centres: one cell more across.
       if (std::min(rect.size.width, rect.size.height) + options.cell_size < options.min_top_depth)
         sliver[first + c] = 1, ++thin;
+    }
+    // Raised onto a support (a goal's top) near the camera's height, the top faces are seen
+    // edge on, a pixel or less deep: they cannot show, and are not asked for.
+    if (support > 0.0) {
+      double range_m = 0.0;
+      for (const cv::Point2f& c : centres) range_m += std::hypot(c.x, c.y) * extent.width_m;
+      range_m /= static_cast<double>(centres.size());
+      const double top_m = (support + top_units) * extent.height_m;
+      const double top_px = camera.config().fy * extent.width_m *
+                            (camera.config().mount.height_m - top_m) /
+                            std::max(range_m * range_m, 1e-6);
+      if (top_px < options.min_top_face_px) {
+        std::fill(sliver.begin(), sliver.end(), uint8_t{0});
+        thin = 0;
+      }
     }
     if (thin > 0 && thin >= options.sliver_fraction * static_cast<int>(groups.size()))
       return result;

@@ -30,6 +30,10 @@ struct ObjectExtent {
   // ... and a blob flatter than this x height_m is not these objects either (floor markings,
   // a low bar of the same colour).
   double min_vertical = 0.7;
+  // Heights above the floor where these objects also rest (TargetKind::rest_heights_m): a blob
+  // whose bottom lies at one (within floor_tolerance) is split as if that were the floor.
+  std::vector<double> rest_heights_m = {};
+  int rest_max_stack = 1;  // the tallest stack placed on any of them
 };
 
 struct SizeSplitOptions {
@@ -55,6 +59,13 @@ struct SizeSplitOptions {
   // refused; fewer thin groups are slivers (objects hidden behind others, cut by the image's
   // edge) whose pixels go to no piece. 0: a single thin group refuses the blob.
   double sliver_fraction = 1.0 / 3.0;
+  // Objects may rest on the supports of ObjectExtent::rest_heights_m (false: the floor only,
+  // as before them).
+  bool rest_on_supports = true;
+  // ... asked only when the top faces can show: for objects resting on a support above the
+  // floor (ObjectExtent::rest_heights_m), only when a top face would be at least this many
+  // pixels deep seen from the camera's height at the objects' range.
+  double min_top_face_px = 2.0;
   // The blob's bottom (its 3rd percentile) at most this x the object's height above the floor:
   // objects rest on it, so a blob raised off it is something else of their colour.
   double floor_tolerance = 0.5;

@@ -34,6 +34,7 @@ struct EvalArgs {
   bool no_attach_test = false;
   bool no_float_test = false;
   bool no_depth_cut = false;
+  bool no_supports = false;
   bool no_sliver_drop = false;
 };
 
@@ -57,6 +58,7 @@ int RunVision(const EvalArgs& args) {
   if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
   options.detect.drop_floating = !args.no_float_test;
   if (args.no_depth_cut) options.detect.depth_cut_min_m = 0.0;
+  options.detect.size_split.rest_on_supports = !args.no_supports;
   if (args.no_sliver_drop) options.detect.size_split.sliver_fraction = 0.0;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
@@ -143,6 +145,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   vision->add_flag("--no-depth-cut", args->no_depth_cut,
                    "do not cut colour masks where the depth jumps (an object and a thing of its "
                    "colour far behind it stay one blob; the detector before, for comparison)");
+  vision->add_flag("--no-supports", args->no_supports,
+                   "split by size only what rests on the floor, not on the supports the season "
+                   "places objects on (the detector before, for comparison)");
   vision->add_flag("--no-sliver-drop", args->no_sliver_drop,
                    "a thin group (a sliver of an object hidden or cut by the image's edge) "
                    "refuses the split by size of its whole pile (the detector before, for "

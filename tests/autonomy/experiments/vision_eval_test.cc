@@ -404,5 +404,23 @@ TEST(VisionEvalTest, ObjectsBeforeThingsOfTheirColourAreFound) {
   }
 }
 
+// Objects rest on what the season file places them on, not only on the floor
+// (ObjectExtent::rest_heights_m): Push Back's blocks on its long goals, 0.40 m up, are split
+// by their size, and their top faces, seen edge on from a camera at about their height, are
+// not asked for. Measured on these 20 arena views, without -> with: recall +0.106 to +0.117
+// per method (kmeans+defects 0.777 -> 0.883), groups counted right 11-12 -> 21-22 of 28,
+// precision -0.006 to +0.024. The test asks for +0.08 of recall, seven more groups and at
+// most 0.015 of precision lost, per method.
+TEST(VisionEvalTest, BlocksOnTheLongGoalsAreCountedOneByOne) {
+  VisionEvalOptions without;
+  without.detect.size_split.rest_on_supports = false;
+  CompareInArena("push_back", 20, {}, without,
+                 [](const VisionMethodScore& a, const VisionMethodScore& b) {
+                   EXPECT_GT(a.Recall(), b.Recall() + 0.08);
+                   EXPECT_GE(a.groups_counted, b.groups_counted + 7);
+                   EXPECT_GT(a.Precision(), b.Precision() - 0.015);
+                 });
+}
+
 }  // namespace
 }  // namespace slamo::autonomy
