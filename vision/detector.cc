@@ -658,7 +658,9 @@ DetectorSetup ObjectDetectorSetup(const field::SeasonConfig& season,
       for (const field::ObjectPlacement& p : season.objects) {
         if (p.type != type.name) continue;
         k.max_stack = std::max(k.max_stack, p.stack_size);
-        if (p.z_m > 0.0 && p.stack_level == 0) {
+        // (Not round kinds: a ball raised on others, Nothing but Net's bonus balls, rests on
+        // no structure, and piles of balls are split by their centres.)
+        if (p.z_m > 0.0 && p.stack_level == 0 && !round) {
           k.rest_max_stack = std::max(k.rest_max_stack, p.stack_size);
           if (std::find(k.rest_heights_m.begin(), k.rest_heights_m.end(), p.z_m) ==
               k.rest_heights_m.end())

@@ -153,7 +153,7 @@ struct TargetKind {
   int max_stack = 1;                 // most of them one on top of another (the season's
                                      // tallest stack placed)
   // Heights above the floor, other than 0, where the season file places them (Push Back's
-  // blocks on the long goals): they may rest there too.
+  // blocks on the long goals): they may rest there too. Not for round kinds.
   std::vector<double> rest_heights_m = {};
   int rest_max_stack = 1;  // the tallest stack placed on any of them
 };

@@ -159,7 +159,13 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
   // the floor: their heights are counted from it.
   // (support: that height, in object heights; 0 on the floor.)
   double support = 0.0;
-  if (options.rest_on_supports) {
+  // Only when the floor does not explain it (top faces of a stack on the floor do).
+  const bool on_floor =
+      bottom <= options.floor_tolerance ||
+      (options.top_faces && height_units < extent.min_vertical && std::round(bottom) >= 1.0 &&
+       std::round(bottom) <= std::max(1, extent.max_stack) &&
+       std::abs(bottom - std::round(bottom)) <= options.top_tolerance);
+  if (options.rest_on_supports && !on_floor) {
     for (const double h : extent.rest_heights_m) {
       const double units = h / extent.height_m;
       if (std::abs(bottom - units) < std::abs(bottom - support)) support = units;
@@ -364,8 +370,10 @@ SizeSplitResult SplitBySize(const cv::Mat& mask, const cv::Mat& depth_mm, cv::Po
     // Raised onto a support (a goal's top) near the camera's height, the top faces are seen
     // edge on, a pixel or less deep: they cannot show, and are not asked for.
     if (support > 0.0) {
+      const Eigen::Vector3d lens = camera.CameraToRobot(Eigen::Vector3d::Zero());
       double range_m = 0.0;
-      for (const cv::Point2f& c : centres) range_m += std::hypot(c.x, c.y) * extent.width_m;
+      for (const cv::Point2f& c : centres)
+        range_m += std::hypot(c.x * extent.width_m - lens.x(), c.y * extent.width_m - lens.y());
       range_m /= static_cast<double>(centres.size());
       const double top_m = (support + top_units) * extent.height_m;
       const double top_px = camera.config().fy * extent.width_m *
