@@ -120,7 +120,8 @@ struct DetectOptions {
   // depth_cut_ratio x the nearer one's depth, and depth_cut_sigmas x its depth noise, all
   // three; the farther pixel is cleared. An object seen against a thing of its own colour far
   // behind it (a poster, a shirt, an alliance wall across the field) is then a blob of its
-  // own. Semi-transparent kinds are not cut: depth reads through them. 0: off.
+  // own. Colours with a semi-transparent kind are not cut (tried on Toss Up: recall up, but
+  // its benchmark view's time nearly doubled; README, Vision). 0: off.
   double depth_cut_min_m = 0.25;
   double depth_cut_ratio = 0.1;
   double depth_cut_sigmas = 4.0;
