@@ -102,19 +102,27 @@ Pose2D Facing(const Eigen::Vector2d& at, double range_m, double bearing_rad = M_
                 at.y() + range_m * std::sin(bearing_rad + M_PI), bearing_rad};
 }
 
+// Puts an object of `type` and `colour` with its centre at `centre_m` into `world`, with id
+// `id`, and adds the id to `ids`.
+void AddObject(int id, const field::ObjectType& type, const std::string& colour,
+               const Eigen::Vector3d& centre_m, platform::SimWorld* world, std::set<int>* ids) {
+  platform::SimObject o;
+  o.id = id;
+  o.type = &type;
+  o.colour = colour;
+  o.center_m = centre_m;
+  world->objects.push_back(o);
+  ids->insert(id);
+}
+
 // `n` objects of `type` in a row along +y from kSpot, touching, resting on the floor; ids 1..n.
 std::set<int> AddRow(const field::ObjectType& type, const std::string& colour, int n,
                      platform::SimWorld* world) {
   std::set<int> ids;
   for (int k = 0; k < n; ++k) {
-    platform::SimObject o;
-    o.id = k + 1;
-    o.type = &type;
-    o.colour = colour;
-    o.center_m =
-        Eigen::Vector3d(kSpot.x(), kSpot.y() + k * type.size_m * 1.001, type.height_m / 2.0);
-    world->objects.push_back(o);
-    ids.insert(o.id);
+    AddObject(k + 1, type, colour,
+              Eigen::Vector3d(kSpot.x(), kSpot.y() + k * type.size_m * 1.001, type.height_m / 2.0),
+              world, &ids);
   }
   return ids;
 }
@@ -162,14 +170,10 @@ TEST(SizeSplitTest, BlocksOnALongGoalAreSplitWhereTheyRest) {
   const Eigen::Vector2d at(-0.083, 1.198);  // between the two blocks
   std::set<int> ids;
   for (int k = 0; k < 2; ++k) {
-    platform::SimObject o;
-    o.id = k + 1;
-    o.type = &block;
-    o.colour = "red";
-    o.center_m =
-        Eigen::Vector3d(at.x() + (k - 0.5) * block.size_m, at.y(), 0.40 + block.height_m / 2.0);
-    scene.world()->objects.push_back(o);
-    ids.insert(o.id);
+    AddObject(
+        k + 1, block, "red",
+        Eigen::Vector3d(at.x() + (k - 0.5) * block.size_m, at.y(), 0.40 + block.height_m / 2.0),
+        scene.world(), &ids);
   }
   DetectOptions floor_only;
   floor_only.size_split.rest_on_supports = false;
@@ -423,13 +427,9 @@ TEST(SizeSplitTest, BlocksBehindALowBarAreSplitBySize) {
       const field::ObjectType& block = scene.Type("block");
       std::set<int> ids;
       for (int k = 0; k < 4; ++k) {
-        platform::SimObject o;
-        o.id = k + 1;
-        o.type = &block;
-        o.colour = "red";
-        o.center_m = Eigen::Vector3d(1.428, -0.123 + 0.082 * k, block.height_m / 2.0);
-        scene.world()->objects.push_back(o);
-        ids.insert(o.id);
+        AddObject(k + 1, block, "red",
+                  Eigen::Vector3d(1.428, -0.123 + 0.082 * k, block.height_m / 2.0), scene.world(),
+                  &ids);
       }
       SCOPED_TRACE("range " + std::to_string(range) + " m, bearing " + std::to_string(bearing));
       const Pose2D pose = Facing(Eigen::Vector2d(1.428, 0.0), range, bearing);
