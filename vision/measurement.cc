@@ -237,6 +237,7 @@ std::optional<BlobSurface> MeasureBlobSurface(const cv::Mat& depth_mm, const cv:
   thread_local std::vector<uint16_t> readings;  // reused: no allocation per blob
   const size_t count = MaskedReadings(depth_mm, inner, box, &readings);
   if (static_cast<int>(count) < options.min_depth_pixels) return std::nullopt;
+  if (count < options.min_depth_fraction * cv::countNonZero(inner)) return std::nullopt;
   const double surface_m = camera.CorrectDepthM(MedianReading(readings.data(), count));
   if (!(surface_m > 0.0)) return std::nullopt;
   return BlobSurface{surface_m, static_cast<int>(count)};

@@ -16,7 +16,10 @@
 namespace slamo::vision {
 
 struct MeasurementOptions {
-  int min_depth_pixels = 5;        // fewer valid readings in the blob: no measurement
+  int min_depth_pixels = 5;  // fewer valid readings in the blob: no measurement
+  // ... or fewer than this share of its pixels: what reads is not the object (one nearer than
+  // the camera's least range, whose few readings are of something beside it).
+  double min_depth_fraction = 0.2;
   int erode_px = 2;                // shrink the blob first: its rim sees the background
   double pixel_sigma_px = 1.0;     // centre uncertainty floor (px)
   double pixel_sigma_ratio = 0.1;  // plus this x the blob radius (partial views, blur)

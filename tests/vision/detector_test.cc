@@ -210,6 +210,41 @@ TEST_F(DetectorTest, NoDepthMeansNoMeasurementNeverNaN) {
   EXPECT_FALSE(found[0].measurement.has_value());
 }
 
+// A piece with readings on few of its pixels (an object nearer than the camera's least range,
+// whose few readings are of something seen beside or through it) is not measured by them
+// (MeasurementOptions::min_depth_fraction): it is kept by its size on the floor, unranged.
+TEST_F(DetectorTest, APieceMostlyWithoutReadingsIsNotRangedByThem) {
+  const SimObject ball = Ball("buckyball", "red", -0.4, 0.2);
+  platform::FrameTruth truth;
+  platform::RgbdFrame frame = Render(pose_, &truth);
+  // One pixel in eight of the ball reads 3.5 m (something beyond it); the rest reads nothing.
+  int k = 0;
+  for (int v = 0; v < frame.depth_mm.rows; ++v) {
+    for (int u = 0; u < frame.depth_mm.cols; ++u) {
+      if (truth.ids.at<uint16_t>(v, u) != ball.id) continue;
+      frame.depth_mm.at<uint16_t>(v, u) = k++ % 8 == 0 ? 3500 : 0;
+    }
+  }
+  ASSERT_GT(k, 200);
+  const double truth_range = TruthRangeBearing(ball, pose_).x();
+  DetectStats stats;
+  std::vector<Detection> found;
+  for (Detection& d : Detect(frame.colour, frame.depth_mm, setup_, {}, &stats)) {
+    if (d.colour == "red") found.push_back(std::move(d));
+  }
+  // Kept: it has a buckyball's size on the floor at the ground plane's range; not ranged.
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].kind, "buckyball");
+  EXPECT_FALSE(found[0].measurement.has_value());
+  EXPECT_EQ(stats.without_depth, 1);
+  // Measured by those readings, it is dropped (too small for 3.5 m) or ranged far off.
+  DetectOptions by_readings;
+  by_readings.measurement.min_depth_fraction = 0.0;
+  found = DetectColour(frame, "red", by_readings);
+  EXPECT_TRUE(found.empty() || !found[0].measurement ||
+              std::abs(found[0].measurement->range_m - truth_range) > 0.5);
+}
+
 TEST_F(DetectorTest, BadInputIsAClearError) {
   const platform::RgbdFrame frame = Render(pose_);
   EXPECT_THROW(Detect(cv::Mat(), cv::Mat(), setup_, {}), std::invalid_argument);
