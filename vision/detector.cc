@@ -1,6 +1,7 @@
 #include "vision/detector.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -200,6 +201,57 @@ std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlie
   *inlier_fraction = points.empty() ? 0.0 : static_cast<double>(inliers.size()) / points.size();
   if (fit) MeasureArc(inliers, &*fit);
   return fit;
+}
+
+// The share of a circle's circumference in view (more than 2 px inside the image) along which
+// the outline runs on it (within the arc fit's tolerance), in 5-degree steps. A ball's
+// outline follows its circle but where something of its colour joins it; a square's, the
+// circle inscribed in it, only about half the way round.
+double CircleOnOutline(const std::vector<cv::Point>& outline, const ArcFit& fit, cv::Size image) {
+  constexpr int kSteps = 72;
+  std::array<bool, kSteps> on{};
+  const double tolerance = std::max(1.5, 0.08 * fit.radius);
+  for (const cv::Point& p : outline) {
+    const cv::Point2d d = cv::Point2d(p) - fit.centre;
+    if (!NearCircle(d, fit.radius, tolerance)) continue;
+    const double turn = std::atan2(d.y, d.x) / (2.0 * M_PI) + 0.5;  // 0..1
+    on[std::min(kSteps - 1, static_cast<int>(turn * kSteps))] = true;
+  }
+  int visible = 0, covered = 0;
+  for (int k = 0; k < kSteps; ++k) {
+    const double angle = ((k + 0.5) / kSteps - 0.5) * 2.0 * M_PI;
+    const cv::Point2d p = fit.centre + fit.radius * cv::Point2d(std::cos(angle), std::sin(angle));
+    if (p.x <= 2.0 || p.y <= 2.0 || p.x >= image.width - 3.0 || p.y >= image.height - 3.0) continue;
+    ++visible;
+    covered += on[k];
+  }
+  return visible > 0 ? static_cast<double>(covered) / visible : 0.0;
+}
+
+// The part of a piece within a circle its outline fits: false, and *piece unchanged, when the
+// piece covers less than min_fill of the circle's area in the image.
+bool CropToDisc(const ArcFit& fit, cv::Size image, double min_fill, std::vector<cv::Point>* piece) {
+  const int r = static_cast<int>(std::ceil(fit.radius)) + 1;
+  const cv::Rect disc_box(cvFloor(fit.centre.x) - r, cvFloor(fit.centre.y) - r, 2 * r + 2,
+                          2 * r + 2);
+  const cv::Rect bounds = (cv::boundingRect(*piece) | disc_box) & cv::Rect(cv::Point(), image);
+  if (bounds.empty()) return false;
+  cv::Mat inside(bounds.size(), CV_8UC1, cv::Scalar(0));
+  FillOutline(*piece, -bounds.tl(), &inside);
+  cv::Mat disc(bounds.size(), CV_8UC1, cv::Scalar(0));
+  cv::circle(disc, fit.centre - cv::Point2d(bounds.tl()), cvRound(fit.radius), cv::Scalar(255),
+             cv::FILLED, cv::LINE_8);
+  const int disc_area = cv::countNonZero(disc);
+  inside &= disc;
+  if (disc_area == 0 || cv::countNonZero(inside) < min_fill * disc_area) return false;
+  std::vector<std::vector<cv::Point>> parts;
+  FindOuterContours(inside, &parts, bounds.tl());
+  if (parts.empty()) return false;
+  *piece =
+      std::move(*std::max_element(parts.begin(), parts.end(), [](const auto& a, const auto& b) {
+        return cv::contourArea(a) < cv::contourArea(b);
+      }));
+  return true;
 }
 
 // Objects rest on something. Just under the lowest pixels of an object on the floor the camera
@@ -769,6 +821,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         std::none_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
     const bool all_round =
         std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
+    const bool semi_round = all_round && !all_solid;  // a semi-transparent ball among them
 
     std::vector<std::vector<cv::Point>> blobs;
     // Cut at depth edges, a blob's region may hold another's (an object framed by the poster
@@ -997,7 +1050,52 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           (sized.objects == 0 && (one_object || blob_area >= options.single_object_solidity *
                                                                  ConvexHullArea(blob, blob_box)));
       SeparationResult separated;
-      if (sized.objects > 1) {
+      // A semi-transparent ball shows what lies behind it through its face: a buckyball, a
+      // highlight or the floor's seams notch its mask, and the cut at concave defects takes it
+      // apart there. When the blob's own outline (not the image border) is in good part a
+      // circle the blob fills, that disc is one piece, and what lies outside it is separated
+      // on its own.
+      std::vector<cv::Point> disc;
+      double disc_radius_px = 0.0;
+      if (sized.objects <= 1 && !convex && semi_round && options.min_disc_fill > 0.0) {
+        std::vector<cv::Point> arc;
+        for (const cv::Point& p : blob) {
+          if (p.x > 1 && p.y > 1 && p.x < bgr.cols - 2 && p.y < bgr.rows - 2) arc.push_back(p);
+        }
+        double inliers = 0.0;
+        const std::optional<ArcFit> fit = FitArc(arc, &inliers);
+        if (fit && fit->rms <= options.max_arc_rms_ratio * fit->radius &&
+            fit->coverage_deg >= options.min_arc_coverage_deg &&
+            fit->radius <= 2.0 * std::sqrt(blob_area / M_PI) + 2.0 &&
+            CircleOnOutline(arc, *fit, bgr.size()) >= options.min_disc_outline) {
+          disc = blob;
+          if (!CropToDisc(*fit, bgr.size(), options.min_disc_fill, &disc)) disc.clear();
+          disc_radius_px = fit->radius;
+        }
+      }
+      if (!disc.empty()) {
+        ++st.semi_discs;
+        // The rest of the blob, 2 px clear of the disc (its rim is the ball's).
+        cv::Mat disc_mask(window.size(), CV_8UC1, cv::Scalar(0));
+        FillOutline(disc, -window.tl(), &disc_mask);
+        cv::dilate(disc_mask, disc_mask, cv::Mat(), cv::Point(-1, -1), 2);
+        cv::Mat rest = blob_mask.clone();
+        rest.setTo(0, disc_mask);
+        // Slivers along the rim (the outline outside the circle, a highlight's edge) are the
+        // ball's: what is thinner than a seventh of its radius goes.
+        const int k = std::max(3, static_cast<int>(0.15 * disc_radius_px) | 1);
+        cv::morphologyEx(rest, rest, cv::MORPH_OPEN,
+                         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+        for (cv::Point& p : disc) p -= window.tl();
+        separated.pieces.push_back(std::move(disc));
+        std::vector<std::vector<cv::Point>> parts;
+        FindOuterContours(rest, &parts);
+        for (std::vector<cv::Point>& part : parts) {
+          if (cv::contourArea(part) >= options.min_area_px) {
+            separated.pieces.push_back(std::move(part));
+          }
+        }
+      } else if (sized.objects > 1) {
         separated.pieces = std::move(sized.pieces);
       } else if (convex) {
         std::vector<cv::Point> shifted = blob;

@@ -73,6 +73,11 @@ struct DetectOptions {
   double max_arc_rms_ratio = 0.1;
   double min_arc_coverage_deg = 120.0;
   double min_arc_inlier_fraction = 0.5;  // share of the outline on the circle
+  // For colours with a semi-transparent ball: a blob, before the cut, whose own outline fits
+  // a circle (as above, but for the inlier fraction) that it fills to this share (in the
+  // image) is that ball, one piece, and the rest of it is separated apart. 0: off.
+  double min_disc_fill = 0.8;
+  double min_disc_outline = 0.6;  // ... and whose outline runs on it this share of the way round
   // With depth, a detection typed as a round solid kind must curve away from the camera
   // (vision/measurement.h MeasureSurfaceBulge): it is dropped as a flat face (a wall, a
   // robot's bumper) when its rims' bulge, plus 3 sigma of the depth noise, stays under this x
@@ -200,6 +205,8 @@ struct DetectStats {
   int rejected_size = 0;
   int rejected_flat = 0;      // round solid kinds whose surface does not curve (a bumper's face)
   int split_by_size = 0;      // blobs separated by the objects' known size
+  int semi_discs = 0;         // blobs of a colour with a semi-transparent ball whose outline's
+                              // circle was taken as one piece before the cut
   int split_spheres = 0;      // blobs (or pieces of the cut no circle fits) separated by the
                               // centres of balls of one size
   int rejected_floating = 0;  // blobs with a part held off the floor over nothing (cleared)

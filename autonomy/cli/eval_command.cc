@@ -36,6 +36,7 @@ struct EvalArgs {
   bool no_depth_cut = false;
   bool no_supports = false;
   bool no_sliver_drop = false;
+  bool no_semi_discs = false;
 };
 
 int RunVision(const EvalArgs& args) {
@@ -60,6 +61,7 @@ int RunVision(const EvalArgs& args) {
   if (args.no_depth_cut) options.detect.depth_cut_min_m = 0.0;
   options.detect.size_split.rest_on_supports = !args.no_supports;
   if (args.no_sliver_drop) options.detect.size_split.sliver_fraction = 0.0;
+  if (args.no_semi_discs) options.detect.min_disc_fill = 0.0;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
       throw std::invalid_argument("--pile MIN,MAX: MIN must not exceed MAX");
@@ -152,6 +154,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
                    "a thin group (a sliver of an object hidden or cut by the image's edge) "
                    "refuses the split by size of its whole pile (the detector before, for "
                    "comparison)");
+  vision->add_flag("--no-semi-discs", args->no_semi_discs,
+                   "cut a semi-transparent ball's blob at its concave defects even when its "
+                   "outline is a circle it fills (the detector before, for comparison)");
   vision->add_option("--pictures", args->pictures,
                      "write annotated views of the 12 worst frames (detections, misses, false "
                      "and off-field detections) here");
