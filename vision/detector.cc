@@ -247,10 +247,14 @@ bool CropToDisc(const ArcFit& fit, cv::Size image, double min_fill, std::vector<
   std::vector<std::vector<cv::Point>> parts;
   FindOuterContours(inside, &parts, bounds.tl());
   if (parts.empty()) return false;
-  *piece =
-      std::move(*std::max_element(parts.begin(), parts.end(), [](const auto& a, const auto& b) {
-        return cv::contourArea(a) < cv::contourArea(b);
-      }));
+  auto largest = std::max_element(parts.begin(), parts.end(), [](const auto& a, const auto& b) {
+    return cv::contourArea(a) < cv::contourArea(b);
+  });
+  // The part kept must fill the circle itself (not only with a part a seam cuts off).
+  cv::Mat kept(bounds.size(), CV_8UC1, cv::Scalar(0));
+  FillOutline(*largest, -bounds.tl(), &kept);
+  if (cv::countNonZero(kept & disc) < min_fill * disc_area) return false;
+  *piece = std::move(*largest);
   return true;
 }
 
@@ -1090,6 +1094,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         separated.pieces.push_back(std::move(disc));
         std::vector<std::vector<cv::Point>> parts;
         FindOuterContours(rest, &parts);
+        // What is left goes on as pieces of its own, not cut further (cut at its concave
+        // defects, Toss Up's arena views lost groups: 0.682 -> 0.667 of 66).
         for (std::vector<cv::Point>& part : parts) {
           if (cv::contourArea(part) >= options.min_area_px) {
             separated.pieces.push_back(std::move(part));

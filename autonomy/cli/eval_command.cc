@@ -155,8 +155,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
                    "refuses the split by size of its whole pile (the detector before, for "
                    "comparison)");
   vision->add_flag("--no-semi-discs", args->no_semi_discs,
-                   "cut a semi-transparent ball's blob at its concave defects even when its "
-                   "outline is a circle it fills (the detector before, for comparison)");
+                   "separate a semi-transparent ball's blob like any other (at its concave "
+                   "defects, or by watershed) even when its outline is a circle it fills (the "
+                   "detector before, for comparison)");
   vision->add_option("--pictures", args->pictures,
                      "write annotated views of the 12 worst frames (detections, misses, false "
                      "and off-field detections) here");
