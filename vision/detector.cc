@@ -206,7 +206,7 @@ std::optional<ArcFit> FitArc(const std::vector<cv::Point>& points, double* inlie
 // The share of a circle's circumference in view (more than 2 px inside the image) along which
 // the outline runs on it (within the arc fit's tolerance), in 5-degree steps. A ball's
 // outline follows its circle but where something of its colour joins it; a square's, the
-// circle inscribed in it, only about half the way round.
+// circle fitted to it (between its inscribed and circumscribed ones), about 0.6 of the way.
 double CircleOnOutline(const std::vector<cv::Point>& outline, const ArcFit& fit, cv::Size image) {
   constexpr int kSteps = 72;
   std::array<bool, kSteps> on{};
@@ -1095,7 +1095,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         std::vector<std::vector<cv::Point>> parts;
         FindOuterContours(rest, &parts);
         // What is left goes on as pieces of its own, not cut further (cut at its concave
-        // defects, Toss Up's arena views lost groups: 0.682 -> 0.667 of 66).
+        // defects, Toss Up's arena views lost groups, 0.682 -> 0.667 of 66, measured with
+        // min_disc_outline 0.6).
         for (std::vector<cv::Point>& part : parts) {
           if (cv::contourArea(part) >= options.min_area_px) {
             separated.pieces.push_back(std::move(part));

@@ -77,7 +77,7 @@ struct DetectOptions {
   // a circle (as above, but for the inlier fraction) that it fills to this share (in the
   // image) is that ball, one piece, and the rest of it is separated apart. 0: off.
   double min_disc_fill = 0.8;
-  double min_disc_outline = 0.6;  // ... and whose outline runs on it this share of the way round
+  double min_disc_outline = 0.7;  // ... and whose outline runs on it this share of the way round
   // With depth, a detection typed as a round solid kind must curve away from the camera
   // (vision/measurement.h MeasureSurfaceBulge): it is dropped as a flat face (a wall, a
   // robot's bumper) when its rims' bulge, plus 3 sigma of the depth noise, stays under this x

@@ -8,6 +8,7 @@
 #include <random>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "field_configs/loader.h"
 #include "platform/sim/sim_renderer.h"
@@ -256,6 +257,46 @@ TEST_F(DetectorTest, BadInputIsAClearError) {
   EXPECT_THROW(Detect(frame.colour, depth8, setup_, {}), std::invalid_argument);
   const cv::Mat small_depth(100, 100, CV_16UC1, cv::Scalar(1000));
   EXPECT_THROW(Detect(frame.colour, small_depth, setup_, {}), std::invalid_argument);
+}
+
+// A semi-transparent ball's blob taken whole (DetectOptions::min_disc_fill,
+// min_disc_outline), on drawn shapes of Toss Up's blue without depth: a ball notched from the
+// top down to near its centre (a highlight seen through it) and from the bottom (a seam) is
+// one ball, with its centre and radius; without the step the cut between the notches takes it
+// apart. A notched square is not taken for a
+// ball: the circle fitted to its outline (radius 66 px, between the inscribed 60 and the
+// circumscribed 85) has the outline on it over 0.61 of the way round, under the 0.7 asked;
+// with no share asked, it is taken for one.
+TEST(SemiDiscTest, ANotchedBallIsOneBallAndANotchedSquareIsNone) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("toss_up");
+  const DetectorSetup setup = ObjectDetectorSetup(season, nullptr);
+  const cv::Scalar grey(128, 128, 128), blue(200, 40, 20);  // BGR
+  cv::Mat image(424, 512, CV_8UC3, grey);
+  const cv::Point ball(170, 250), square(400, 120);
+  cv::circle(image, ball, 70, blue, cv::FILLED);
+  const std::vector<cv::Point> notch = {{150, 170}, {190, 170}, {170, 240}};
+  cv::fillConvexPoly(image, notch, grey);
+  const std::vector<cv::Point> low_notch = {{160, 330}, {180, 330}, {170, 290}};
+  cv::fillConvexPoly(image, low_notch, grey);
+  cv::rectangle(image, square - cv::Point(60, 60), square + cv::Point(60, 60), blue, cv::FILLED);
+  const std::vector<cv::Point> square_notch = {{385, 60}, {415, 60}, {400, 95}};
+  cv::fillConvexPoly(image, square_notch, grey);
+  const auto near = [&](const DetectOptions& options, cv::Point at, double radius) {
+    const std::vector<Detection> found = Detect(image, cv::Mat(), setup, options);
+    return std::count_if(found.begin(), found.end(), [&](const Detection& d) {
+      return d.colour == "blue" && cv::norm(d.centre_px - cv::Point2d(at)) < 0.1 * radius &&
+             std::abs(d.radius_px - radius) < 0.1 * radius;
+    });
+  };
+  const DetectOptions options;
+  EXPECT_EQ(near(options, ball, 70), 1);
+  EXPECT_EQ(near(options, square, 60), 0);
+  DetectOptions without = options;
+  without.min_disc_fill = 0.0;
+  EXPECT_EQ(near(without, ball, 70), 0);
+  DetectOptions any_outline = options;
+  any_outline.min_disc_outline = 0.0;
+  EXPECT_EQ(near(any_outline, square, 60), 1);
 }
 
 // Shapes per type (issue #16 item 3): objects that are not round have concave outlines of
