@@ -1338,8 +1338,12 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                 const std::optional<LeastCurvature> least = MeasureLeastCurvature(
                     depth_roi, piece_mask, roi.tl(), *setup.camera, surface->depth_m,
                     best->radius_m, options.measurement.erode_px);
+                // Signed: a ball curves away from the camera every way; a piece curving
+                // towards it along some direction (a saddle where a bumper meets its chassis, a
+                // hollow) is not one, however strongly it curves.
                 if (least &&
-                    std::abs(least->curvature) + options.flat_curvature_sigmas * least->sigma <
+                    (options.convex_curvature ? least->curvature : std::abs(least->curvature)) +
+                            options.flat_curvature_sigmas * least->sigma <
                         options.flat_curvature_ratio / best->radius_m) {
                   ++st.rejected_flat;
                   continue;

@@ -85,7 +85,7 @@ struct DetectOptions {
   // camera (a sphere of its width), about 0.12. 0 turns the test off.
   double min_bulge_ratio = 0.1;
   // ... and must curve in every direction, not only across one (MeasureLeastCurvature): a
-  // piece whose curvature nearest zero, in either sign, plus flat_curvature_sigmas of its
+  // piece whose curvature nearest zero (signed: below) plus flat_curvature_sigmas of its
   // depth-noise sigma, stays under flat_curvature_ratio / the kind's radius is flat along some
   // direction (a bumper's noodle or a box edge, convex or concave, running any way in the
   // image, which the bulge test's row and column bands miss when it runs diagonally) and is
@@ -93,6 +93,10 @@ struct DetectOptions {
   // width) about 0.5. 0: off.
   double flat_curvature_ratio = 0.3;
   double flat_curvature_sigmas = 2.0;
+  // ... signed: a piece curving towards the camera along some direction (its least curvature
+  // negative: a saddle, a hollow) is dropped however strongly it curves. false: by the
+  // curvature's size alone (the detector before, for comparison).
+  bool convex_curvature = true;
   // With depth, for colours of solid kinds with flat bases (no round kind: rings, cubes,
   // blocks, goals): the part of a blob held off the floor over nothing is cleared (a robot's
   // bumper, alone or touching an object). A column floats when the farthest of the

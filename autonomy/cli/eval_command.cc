@@ -31,6 +31,7 @@ struct EvalArgs {
   bool no_sphere_pieces = false;
   bool no_bulge_test = false;
   bool no_curvature_test = false;
+  bool either_curvature = false;
   bool no_attach_test = false;
   bool no_float_test = false;
   bool no_depth_cut = false;
@@ -56,6 +57,7 @@ int RunVision(const EvalArgs& args) {
   options.detect.split_sphere_pieces = !args.no_sphere_pieces;
   if (args.no_bulge_test) options.detect.min_bulge_ratio = 0.0;
   if (args.no_curvature_test) options.detect.flat_curvature_ratio = 0.0;
+  options.detect.convex_curvature = !args.either_curvature;
   if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
   options.detect.drop_floating = !args.no_float_test;
   if (args.no_depth_cut) options.detect.depth_cut_min_m = 0.0;
@@ -138,6 +140,10 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   vision->add_flag("--no-curvature-test", args->no_curvature_test,
                    "keep round detections flat along some direction (the detector before the "
                    "test, for comparison)");
+  vision->add_flag("--either-curvature", args->either_curvature,
+                   "in the curvature test, keep round detections that curve strongly towards "
+                   "the camera (a saddle, a hollow) as well as away (the detector before, for "
+                   "comparison)");
   vision->add_flag("--no-attach-test", args->no_attach_test,
                    "keep pieces whose top runs on into a taller body at their depth (a "
                    "bumper under its chassis; the detector before the test, for comparison)");
