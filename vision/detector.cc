@@ -1252,6 +1252,21 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             d.kind = on_floor.kind;
             ++st.without_depth;
           } else {
+            if (piece_sized && options.min_sized_area_ratio > 0.0) {
+              // ... but not a strip of its rim under a tenth of the smallest kind's area at
+              // its depth (mixed readings there cluster apart on the floor).
+              double smallest = std::numeric_limits<double>::infinity();
+              for (const TargetKind& k : kinds) {
+                if (k.radius_m > 0.0)
+                  smallest = std::min(
+                      smallest, focal * k.radius_m / (surface->depth_m + k.surface_to_centre_m));
+              }
+              if (std::isfinite(smallest) &&
+                  d.area_px < options.min_sized_area_ratio * M_PI * smallest * smallest) {
+                ++st.rejected_small;
+                continue;
+              }
+            }
             // A piece split off by size is an object: only its kind is in question.
             const TargetKind* best = nullptr;
             double best_ratio =

@@ -36,6 +36,9 @@ struct DetectOptions {
   size_t separation_max_pixels = 6000;    // larger blob windows are separated scaled down
   double min_expected_area_ratio = 0.15;  // with depth: blobs below this x the expected area go
   double size_tolerance = 1.8;  // with depth: apparent radius within [1/x, x] of an object's
+  // With depth, a piece split off by the objects' size (or the balls' centres) below this x
+  // the smallest kind's apparent area at its depth is a strip of a rim, not an object. 0: off.
+  double min_sized_area_ratio = 0.1;
   // With depth, a blob of a colour with no round kind that is at most one object's apparent
   // diagonal wide and tall (plus this, px: the outline's pixel quantisation) is not separated.
   double extent_margin_px = 2.0;

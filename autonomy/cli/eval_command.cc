@@ -32,6 +32,7 @@ struct EvalArgs {
   bool no_bulge_test = false;
   bool no_curvature_test = false;
   bool either_curvature = false;
+  bool keep_small_pieces = false;
   bool no_attach_test = false;
   bool no_float_test = false;
   bool no_depth_cut = false;
@@ -58,6 +59,7 @@ int RunVision(const EvalArgs& args) {
   if (args.no_bulge_test) options.detect.min_bulge_ratio = 0.0;
   if (args.no_curvature_test) options.detect.flat_curvature_ratio = 0.0;
   options.detect.convex_curvature = !args.either_curvature;
+  if (args.keep_small_pieces) options.detect.min_sized_area_ratio = 0.0;
   if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
   options.detect.drop_floating = !args.no_float_test;
   if (args.no_depth_cut) options.detect.depth_cut_min_m = 0.0;
@@ -144,6 +146,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
                    "in the curvature test, keep round detections that curve strongly towards "
                    "the camera (a saddle, a hollow) as well as away (the detector before, for "
                    "comparison)");
+  vision->add_flag("--keep-small-pieces", args->keep_small_pieces,
+                   "keep pieces split off by size however small (strips of a rim; the detector "
+                   "before, for comparison)");
   vision->add_flag("--no-attach-test", args->no_attach_test,
                    "keep pieces whose top runs on into a taller body at their depth (a "
                    "bumper under its chassis; the detector before the test, for comparison)");
