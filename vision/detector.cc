@@ -1353,13 +1353,18 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                 const std::optional<LeastCurvature> least = MeasureLeastCurvature(
                     depth_roi, piece_mask, roi.tl(), *setup.camera, surface->depth_m,
                     best->radius_m, options.measurement.erode_px);
-                // Signed: a ball curves away from the camera every way; a piece curving
-                // towards it along some direction (a saddle where a bumper meets its chassis, a
-                // hollow) is not one, however strongly it curves.
-                if (least &&
-                    (options.convex_curvature ? least->curvature : std::abs(least->curvature)) +
-                            options.flat_curvature_sigmas * least->sigma <
-                        options.flat_curvature_ratio / best->radius_m) {
+                // Signed: a ball curves away from the camera every way, so the lowest
+                // curvature is judged (not the one nearest zero): a piece curving towards it
+                // along some direction (a saddle where a bumper meets its chassis, a hollow)
+                // is not one, however strongly it curves either way.
+                const double curvature = !least                     ? 0.0
+                                         : options.convex_curvature ? least->lowest
+                                                                    : std::abs(least->curvature);
+                const double sigma = !least                     ? 0.0
+                                     : options.convex_curvature ? least->lowest_sigma
+                                                                : least->sigma;
+                if (least && curvature + options.flat_curvature_sigmas * sigma <
+                                 options.flat_curvature_ratio / best->radius_m) {
                   ++st.rejected_flat;
                   continue;
                 }

@@ -96,9 +96,9 @@ struct DetectOptions {
   // width) about 0.5. 0: off.
   double flat_curvature_ratio = 0.3;
   double flat_curvature_sigmas = 2.0;
-  // ... signed: a piece curving towards the camera along some direction (its least curvature
-  // negative: a saddle, a hollow) is dropped however strongly it curves. false: by the
-  // curvature's size alone (the detector before, for comparison).
+  // ... signed: the lowest curvature is judged, not the one nearest zero, so a piece curving
+  // towards the camera along some direction (a saddle, a hollow) is dropped however strongly
+  // it curves. false: the size of the one nearest zero (the detector before, for comparison).
   bool convex_curvature = true;
   // With depth, for colours of solid kinds with flat bases (no round kind: rings, cubes,
   // blocks, goals): the part of a blob held off the floor over nothing is cleared (a robot's

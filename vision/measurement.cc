@@ -118,14 +118,18 @@ std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, con
   // Its uncertainty from the camera's depth noise (the robot file's model) at this depth,
   // through the fit's covariance, along that direction v (d lambda = v' dH v).
   const double noise = camera.DepthSigmaM(depth_m);
-  const Eigen::Vector2d v = eigen.eigenvectors().col(least);
-  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-  g(3) = 2.0 * v.x() * v.x();
-  g(4) = 2.0 * v.x() * v.y();
-  g(5) = 2.0 * v.y() * v.y();
-  const Eigen::Matrix<double, 6, 1> gs = scale.asDiagonal() * g;
-  const double variance = noise * noise * gs.dot(solver.solve(gs));
-  return LeastCurvature{eigen.eigenvalues()(least), std::sqrt(std::max(0.0, variance))};
+  const auto sigma_along = [&](int k) {
+    const Eigen::Vector2d v = eigen.eigenvectors().col(k);
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    g(3) = 2.0 * v.x() * v.x();
+    g(4) = 2.0 * v.x() * v.y();
+    g(5) = 2.0 * v.y() * v.y();
+    const Eigen::Matrix<double, 6, 1> gs = scale.asDiagonal() * g;
+    return std::sqrt(std::max(0.0, noise * noise * gs.dot(solver.solve(gs))));
+  };
+  // The eigenvalues come in increasing order: the lowest is the first.
+  return LeastCurvature{eigen.eigenvalues()(least), sigma_along(least), eigen.eigenvalues()(0),
+                        sigma_along(0)};
 }
 
 size_t MaskedReadings(const cv::Mat& depth_mm, const cv::Mat& mask, const cv::Rect& box,

@@ -93,6 +93,10 @@ std::optional<SurfaceBulge> MeasureSurfaceBulge(const cv::Mat& depth_mm, const c
 struct LeastCurvature {
   double curvature = 0.0;  // 1/m
   double sigma = 0.0;      // 1/m
+  // The lowest, signed (the same as `curvature` where the surface curves away both ways;
+  // below zero where it curves towards the camera along some direction: a saddle, a hollow).
+  double lowest = 0.0;        // 1/m
+  double lowest_sigma = 0.0;  // 1/m
 };
 std::optional<LeastCurvature> MeasureLeastCurvature(const cv::Mat& depth_mm, const cv::Mat& mask,
                                                     cv::Point offset, const CameraModel& camera,

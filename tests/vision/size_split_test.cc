@@ -244,8 +244,9 @@ TEST(SizeSplitTest, ABumperOffTheFloorIsNotTakenForRings) {
 // seen from 2 m and more, where the bumper's top face is a pixel tall and its step, about its
 // 6 cm thickness, is as deep as a triball touching a wall seen from there); the test asks for
 // at least 12 before and half as many after. Both with the curvature test unsigned, as it was
-// then: signed (DetectOptions::convex_curvature), it alone leaves 3 of the 16 (a bumper's
-// piece curves towards the camera where it meets the chassis); asked: half as many.
+// then (since strips of a rim are dropped, DetectOptions::min_sized_area_ratio: 15 -> 4).
+// Signed (DetectOptions::convex_curvature), it alone leaves 3 of the 15 (a bumper's piece
+// curves towards the camera where it meets the chassis); asked: half as many.
 TEST(AttachedTest, ABumperUnderItsChassisIsNotTakenForTriballs) {
   int before_total = 0, after_total = 0, signed_total = 0;
   for (const double yaw : {0.0, 0.5, 1.0}) {
@@ -594,6 +595,8 @@ TEST(SurfaceCurvatureTest, ABallCurvesEveryWayAnEdgeAndANoodleDoNot) {
     ASSERT_TRUE(least.has_value());
     EXPECT_NEAR(least->curvature * radius_m, 1.0, 0.5);
     EXPECT_GT(least->curvature - 2.0 * least->sigma, 0.3 / radius_m);
+    // It curves away every way: its lowest curvature, signed, is as clear of the threshold.
+    EXPECT_GT(least->lowest - 2.0 * least->lowest_sigma, 0.3 / radius_m);
   }
   // Surfaces drawn exactly (raw readings through the camera's depth correction), 1 m ahead,
   // through the centre's ray; s: the distance across the edge (or the noodle's axis) at unit
@@ -645,6 +648,29 @@ TEST(SurfaceCurvatureTest, ABallCurvesEveryWayAnEdgeAndANoodleDoNot) {
           ASSERT_TRUE(bulge.has_value());
           EXPECT_GT(bulge->bulge_m - 3.0 * bulge->sigma_m, 0.1 * radius_m);
         }
+      }
+    }
+  }
+  // Curving towards the camera along some direction (DetectOptions::convex_curvature): a
+  // saddle curving towards it more strongly than away (the curvature nearest zero, +15 / m,
+  // is as clear of 0.3 / R as a ball's) and a hollow (the inside of a ball of radius R) are
+  // judged by their lowest curvature, signed, which is well below zero.
+  const auto quadric = [](double across, double along) {
+    return [=](double s, double t) { return 1.0 + 0.5 * (across * s * s + along * t * t); };
+  };
+  const std::vector<std::pair<std::string, Surface>> towards_camera = {
+      {"saddle", quadric(15.0, -30.0)}, {"hollow", quadric(-1.0 / radius_m, -1.0 / radius_m)}};
+  for (double turn_deg : {0.0, 45.0, 90.0}) {
+    for (const auto& [name, surface] : towards_camera) {
+      SCOPED_TRACE(name + " turned " + std::to_string(turn_deg) + " deg");
+      const std::optional<LeastCurvature> least =
+          MeasureLeastCurvature(draw(surface, turn_deg), mask, cv::Point(), camera, 1.0, radius_m);
+      ASSERT_TRUE(least.has_value());
+      EXPECT_LT(least->lowest + 2.0 * least->lowest_sigma, 0.0);
+      if (name == "saddle") {
+        EXPECT_NEAR(least->curvature, 15.0, 1.5);
+        EXPECT_NEAR(least->lowest, -30.0, 3.0);
+        EXPECT_GT(std::abs(least->curvature) - 2.0 * least->sigma, 0.3 / radius_m);
       }
     }
   }

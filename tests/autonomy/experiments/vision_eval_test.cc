@@ -143,11 +143,16 @@ TEST(VisionEvalTest, FlatFacesAreNotTakenForRoundObjects) {
 // [--no-sphere-split]`: recall +0.17 (threshold+defects, 0.805 -> 0.977) to +0.62
 // (kmeans+none, 0.299 -> 0.920), precision 0.87-0.95 -> 0.991-0.992, groups counted right
 // 0.04-0.71 -> 0.88-0.96 of 24; the test asks for +0.1 recall, no precision lost and more
-// groups counted right.
+// groups counted right. Both with the curvature test judging the curvature nearest zero, as
+// then: judging the lowest (DetectOptions::convex_curvature) drops pieces spanning two balls,
+// whose valley curves towards the camera, and without the split the threshold methods' 3 false
+// detections on these views go (precision 1.000, recall 0.793 -> 0.770, threshold+defects).
 TEST(VisionEvalTest, TouchingBallsAreCountedByTheirCentres) {
-  VisionEvalOptions without;
+  VisionEvalOptions with;
+  with.detect.convex_curvature = false;
+  VisionEvalOptions without = with;
   without.detect.split_spheres = false;
-  const std::vector<VisionMethodScore> with_split = Scores("nothing_but_net", 10, 1, true);
+  const std::vector<VisionMethodScore> with_split = Scores("nothing_but_net", 10, 1, true, with);
   const std::vector<VisionMethodScore> without_split =
       Scores("nothing_but_net", 10, 1, true, without);
   ASSERT_EQ(with_split.size(), without_split.size());
@@ -232,6 +237,7 @@ TEST(VisionEvalTest, BumpersOffTheFloorAreNotTakenForRings) {
 TEST(VisionEvalTest, BumperPiecesFlatAlongTheirLengthAreNotTakenForTriballs) {
   VisionEvalOptions with;
   with.detect.attach_margin_ratio = 0.0;
+  with.detect.convex_curvature = false;  // unsigned, as then (below: signed)
   VisionEvalOptions without = with;
   without.detect.flat_curvature_ratio = 0.0;
   const ArenaComparison r = CompareInArena(
@@ -258,7 +264,7 @@ TEST(VisionEvalTest, BumperPiecesCurvingTowardsTheCameraAreNotTakenForTriballs) 
       });
   EXPECT_GT(r.on_robots_without, 18);
   EXPECT_LE(2 * r.on_robots, r.on_robots_without);
-  EXPECT_GE(r.found, r.found_without - 1);
+  EXPECT_EQ(r.found, r.found_without);
 }
 
 // A piece split off by size under a tenth of the smallest kind's apparent area at its depth
