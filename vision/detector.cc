@@ -331,12 +331,12 @@ double StandingHeightM(const cv::Mat& piece_mask, cv::Point offset, const cv::Ma
   return heights[heights.size() - 1 - cut] - low;
 }
 
-// DetectOptions::depth_cut_min_m: clears, in `mask`, the farther pixel of every pair of
-// 8-connected neighbours of it whose depths differ by more than the cut (pixels without a
+// DetectOptions::depth_cut_min_m (`min_m`): clears, in `mask`, the farther pixel of every pair
+// of 8-connected neighbours of it whose depths differ by more than the cut (pixels without a
 // reading are left: a line of them still joins what it runs between). Returns how many
 // clearings were made (a pixel may be counted more than once): 0 when nothing was cut.
 int CutAtDepthEdges(const cv::Mat& depth_mm, const CameraModel& camera,
-                    const DetectOptions& options, cv::Mat* mask) {
+                    const DetectOptions& options, double min_m, cv::Mat* mask) {
   thread_local std::vector<cv::Point> cleared;
   cleared.clear();
   const int rows = mask->rows, cols = mask->cols;
@@ -346,7 +346,7 @@ int CutAtDepthEdges(const cv::Mat& depth_mm, const CameraModel& camera,
   const auto jumps = [&](uint16_t raw_a, uint16_t raw_b) {
     const double a = offset + scale * raw_a, b = offset + scale * raw_b;
     const double near = std::min(a, b), step = std::abs(a - b);
-    return step > options.depth_cut_min_m && step > options.depth_cut_ratio * near &&
+    return step > min_m && step > options.depth_cut_ratio * near &&
            step > options.depth_cut_sigmas * camera.DepthSigmaM(near);
   };
   const auto farther = [&](uint16_t raw_a, uint16_t raw_b) {
@@ -835,7 +835,10 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
     std::vector<int> blob_label;
     if (have_depth && all_solid && options.depth_cut_min_m > 0.0) {
       cv::Mat cut = masks[j].clone();
-      if (CutAtDepthEdges(depth_mm, *setup.camera, options, &cut) > 0) {
+      const double cut_min_m = none_round && options.depth_cut_min_flat_m > 0.0
+                                   ? options.depth_cut_min_flat_m
+                                   : options.depth_cut_min_m;
+      if (CutAtDepthEdges(depth_mm, *setup.camera, options, cut_min_m, &cut) > 0) {
         cv::Mat region_stats, centroids;
         const int regions =
             cv::connectedComponentsWithStats(cut, labels, region_stats, centroids, 8, CV_32S);

@@ -33,6 +33,7 @@ struct EvalArgs {
   bool no_curvature_test = false;
   bool either_curvature = false;
   bool keep_small_pieces = false;
+  bool same_depth_cut = false;
   bool no_attach_test = false;
   bool no_float_test = false;
   bool no_depth_cut = false;
@@ -63,6 +64,7 @@ int RunVision(const EvalArgs& args) {
   if (args.no_attach_test) options.detect.attach_margin_ratio = 0.0;
   options.detect.drop_floating = !args.no_float_test;
   if (args.no_depth_cut) options.detect.depth_cut_min_m = 0.0;
+  if (args.same_depth_cut) options.detect.depth_cut_min_flat_m = 0.0;
   options.detect.size_split.rest_on_supports = !args.no_supports;
   if (args.no_sliver_drop) options.detect.size_split.sliver_fraction = 0.0;
   if (args.no_semi_discs) options.detect.min_disc_fill = 0.0;
@@ -158,6 +160,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
   vision->add_flag("--no-depth-cut", args->no_depth_cut,
                    "do not cut colour masks where the depth jumps (an object and a thing of its "
                    "colour far behind it stay one blob; the detector before, for comparison)");
+  vision->add_flag("--same-depth-cut", args->same_depth_cut,
+                   "cut colours with no round kind at the depth step of the others (0.25 m), not "
+                   "0.1 m (the detector before, for comparison)");
   vision->add_flag("--no-supports", args->no_supports,
                    "split by size only what rests on the floor, not on the supports the season "
                    "places objects on (the detector before, for comparison)");

@@ -275,10 +275,12 @@ TEST(VisionEvalTest, BumperPiecesCurvingTowardsTheCameraAreNotTakenForTriballs) 
 // nothing 15 -> 3 over the six methods, precision up for each (kmeans+defects 0.879 ->
 // 0.921), the same objects found.
 TEST(VisionEvalTest, StripsOfARimAreNotObjects) {
-  VisionEvalOptions without;
+  VisionEvalOptions with;
+  with.detect.depth_cut_min_flat_m = 0.0;  // as then: the 0.1 m cut parts many strips off too
+  VisionEvalOptions without = with;
   without.detect.min_sized_area_ratio = 0.0;
   const ArenaComparison r = CompareInArena(
-      "high_stakes", 20, {}, without, [](const VisionMethodScore& a, const VisionMethodScore& b) {
+      "high_stakes", 20, with, without, [](const VisionMethodScore& a, const VisionMethodScore& b) {
         EXPECT_GT(a.Precision(), b.Precision());
         EXPECT_EQ(a.found, b.found);
       });
@@ -316,9 +318,11 @@ TEST(VisionEvalTest, BumperPiecesUnderTheirChassisAreNotTakenForTriballs) {
 // +0.099 (kmeans+defects 0.876 -> 0.930), precision -0.025 to +0.001. The test asks for +0.04
 // of recall and at most 0.03 of precision lost, per method.
 TEST(VisionEvalTest, ASliverDoesNotRefuseAPileOfCubes) {
-  VisionEvalOptions without;
+  VisionEvalOptions with;
+  with.detect.depth_cut_min_flat_m = 0.0;  // as then: the 0.1 m cut parts many piles too
+  VisionEvalOptions without = with;
   without.detect.size_split.sliver_fraction = 0.0;
-  CompareInArena("skyrise", 20, {}, without,
+  CompareInArena("skyrise", 20, with, without,
                  [](const VisionMethodScore& a, const VisionMethodScore& b) {
                    EXPECT_GT(a.Recall(), b.Recall() + 0.04);
                    EXPECT_GT(a.Precision(), b.Precision() - 0.03);
@@ -419,9 +423,11 @@ TEST(VisionEvalTest, PilesAreCountedWithTheSplitBySize) {
 // 0.826 -> 0.861, 0.930 -> 0.930, 32 -> 36. The test asks for precision up, no recall lost,
 // and three more groups counted right.
 TEST(VisionEvalTest, ObjectsApartOnTheFloorAreNotCutByTheSizeSplit) {
-  VisionEvalOptions one_part;
+  VisionEvalOptions as_then;
+  as_then.detect.depth_cut_min_flat_m = 0.0;  // the 0.1 m cut parts many of them too
+  VisionEvalOptions one_part = as_then;
   one_part.detect.size_split.link_fraction = 0.0;  // as before: a level is one part
-  const std::vector<VisionMethodScore> parts = Scores("skyrise", 20, 1, true);
+  const std::vector<VisionMethodScore> parts = Scores("skyrise", 20, 1, true, as_then);
   const std::vector<VisionMethodScore> whole = Scores("skyrise", 20, 1, true, one_part);
   ASSERT_EQ(parts.size(), whole.size());
   for (size_t k : {0, 3}) {
@@ -439,18 +445,40 @@ TEST(VisionEvalTest, ObjectsApartOnTheFloorAreNotCutByTheSizeSplit) {
 // with the cut: Push Back recall +0.107 to +0.155 per method (kmeans+defects 0.660 -> 0.777),
 // precision +0.003 to +0.035; Skyrise recall +0.020 to +0.061 (0.892 -> 0.930), precision
 // +0.009 to +0.047, false detections on pieces of cubes 154 -> 109 over the six methods. The
-// test asks for precision up and +0.015 of recall, per method and season.
+// test asks for precision up and +0.015 of recall, per method and season. With the cut at
+// 0.25 m for every colour, as then (below: 0.1 m for colours with no round kind).
 TEST(VisionEvalTest, ObjectsBeforeThingsOfTheirColourAreFound) {
-  VisionEvalOptions without;
+  VisionEvalOptions with;
+  with.detect.depth_cut_min_flat_m = 0.0;
+  VisionEvalOptions without = with;
   without.detect.depth_cut_min_m = 0.0;
   for (const char* season : {"push_back", "skyrise"}) {
     SCOPED_TRACE(season);
-    CompareInArena(season, 20, {}, without,
+    CompareInArena(season, 20, with, without,
                    [](const VisionMethodScore& a, const VisionMethodScore& b) {
                      EXPECT_GT(a.Precision(), b.Precision());
                      EXPECT_GT(a.Recall(), b.Recall() + 0.015);
                    });
   }
+}
+
+// Colours with no round kind are cut at a depth step of 0.1 m, not 0.25 m
+// (DetectOptions::depth_cut_min_flat_m): a block touching, in the image, a structure of its
+// colour a little behind it (a long goal's base) is cut from it, and the split by size, which
+// refused the blob (its top at no whole number of block heights), counts it. Measured with
+// `slamo eval vision --season push_back --arena --frames 20 --seed 1 [--same-depth-cut]`:
+// recall +0.030 to +0.039 per method (kmeans+defects 0.883 -> 0.922), precision -0.014 to
+// +0.006, groups counted right 21-22 -> 22-23 of 28. The test asks for +0.02 of recall, at most
+// 0.02 of precision lost and no group fewer, per method.
+TEST(VisionEvalTest, BlocksBesideAStructureOfTheirColourAreCut) {
+  VisionEvalOptions without;
+  without.detect.depth_cut_min_flat_m = 0.0;
+  CompareInArena("push_back", 20, {}, without,
+                 [](const VisionMethodScore& a, const VisionMethodScore& b) {
+                   EXPECT_GT(a.Recall(), b.Recall() + 0.02);
+                   EXPECT_GT(a.Precision(), b.Precision() - 0.02);
+                   EXPECT_GE(a.groups_counted, b.groups_counted);
+                 });
 }
 
 // Objects rest on what the season file places them on, not only on the floor
