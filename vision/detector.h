@@ -138,7 +138,8 @@ struct DetectOptions {
   // ... for colours none of whose kinds is round (cubes, blocks, rings, goals), which the split
   // by size takes apart only when the blob's top is a whole number of their heights: an object
   // touching, in the image, a structure of its colour a little behind it (a goal's base) is
-  // cut from it at this step. 0: depth_cut_min_m for them too.
+  // cut from it at this step (landmarks' colours too: their kind is not round). 0:
+  // depth_cut_min_m for them too; depth_cut_min_m 0 turns both off.
   double depth_cut_min_flat_m = 0.1;
   double depth_cut_ratio = 0.1;
   double depth_cut_sigmas = 4.0;
