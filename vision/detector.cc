@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -226,6 +227,40 @@ double CircleOnOutline(const std::vector<cv::Point>& outline, const ArcFit& fit,
     covered += on[k];
   }
   return visible > 0 ? static_cast<double>(covered) / visible : 0.0;
+}
+
+// Whether every ball SplitSpheres found fills its disc in the image: of the pixels of the
+// ball's outline as the camera sees it (its centre projected, radius f r / z; inside the
+// image), at least min_fill lie on `mask` (window coordinates, at `window_tl` in the image).
+// Two small balls one above another explain a larger sphere's front as well as it does, but
+// cover a fraction of its disc; a semi-transparent ball, ragged as its mask is, most of it.
+bool BallsFillDiscs(const SphereSplitResult& balls, double radius_m, const CameraModel& camera,
+                    const cv::Mat& mask, cv::Point window_tl, cv::Size image, double min_fill) {
+  const Eigen::Vector3d eye = camera.CameraToRobot(Eigen::Vector3d::Zero());
+  Eigen::Matrix3d robot_from_camera;
+  for (int i = 0; i < 3; ++i)
+    robot_from_camera.col(i) = camera.CameraToRobot(Eigen::Vector3d::Unit(i)) - eye;
+  for (const Eigen::Vector3d& centre : balls.centres) {
+    const Eigen::Vector3d in_camera = robot_from_camera.transpose() * (centre - eye);
+    if (in_camera.z() <= radius_m) return false;
+    const Eigen::Vector2d uv = camera.Project(in_camera);
+    const double r_px = camera.config().fx * radius_m / in_camera.z();
+    const int r = static_cast<int>(std::ceil(r_px));
+    const cv::Rect box = cv::Rect(cvFloor(uv.x()) - r, cvFloor(uv.y()) - r, 2 * r + 2, 2 * r + 2) &
+                         cv::Rect(cv::Point(), image);
+    int disc = 0, on = 0;
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        if ((u - uv.x()) * (u - uv.x()) + (v - uv.y()) * (v - uv.y()) > r_px * r_px) continue;
+        ++disc;
+        const cv::Point local(u - window_tl.x, v - window_tl.y);
+        on += local.x >= 0 && local.y >= 0 && local.x < mask.cols && local.y < mask.rows &&
+              mask.at<uint8_t>(local) != 0;
+      }
+    }
+    if (disc == 0 || on < min_fill * disc) return false;
+  }
+  return true;
 }
 
 // The part of a piece within a circle its outline fits: false, and *piece unchanged, when the
@@ -826,6 +861,11 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
     const bool all_round =
         std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
     const bool semi_round = all_round && !all_solid;  // a semi-transparent ball among them
+    // The semi-transparent ball among them (the largest, if more than one).
+    const TargetKind* semi_kind = nullptr;
+    for (const TargetKind& k : kinds) {
+      if (k.round && !k.solid && (!semi_kind || k.radius_m > semi_kind->radius_m)) semi_kind = &k;
+    }
 
     std::vector<std::vector<cv::Point>> blobs;
     // Cut at depth edges, a blob's region may hold another's (an object framed by the poster
@@ -1057,6 +1097,9 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           (sized.objects == 0 && (one_object || blob_area >= options.single_object_solidity *
                                                                  ConvexHullArea(blob, blob_box)));
       SeparationResult separated;
+      // Pieces whose kind is already known (a semi-transparent ball found by its depth), by
+      // index into separated.pieces.
+      std::map<size_t, const TargetKind*> piece_kinds;
       // A semi-transparent ball shows what lies behind it through its face: a buckyball, a
       // highlight or the floor's seams notch its mask, and the cut at concave defects takes it
       // apart there. When the blob's own outline (not the image border) is in good part a
@@ -1080,31 +1123,35 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
           disc_radius_px = fit->radius;
         }
       }
-      if (!disc.empty()) {
-        ++st.semi_discs;
-        // The rest of the blob, 2 px clear of the disc (its rim is the ball's).
-        cv::Mat disc_mask(window.size(), CV_8UC1, cv::Scalar(0));
-        FillOutline(disc, -window.tl(), &disc_mask);
-        cv::dilate(disc_mask, disc_mask, cv::Mat(), cv::Point(-1, -1), 2);
+      // The balls found whole (a disc, or semi-transparent balls by their depth, below) are
+      // the first pieces; the rest of the blob, 2 px clear of them (their rims are theirs),
+      // goes on as pieces of its own, not cut further (cut at its concave defects, Toss Up's
+      // arena views lost groups, 0.682 -> 0.667 of 66, measured with min_disc_outline 0.6).
+      const auto add_rest = [&](double ball_radius_px) {
+        cv::Mat balls_mask(window.size(), CV_8UC1, cv::Scalar(0));
+        for (const std::vector<cv::Point>& ball : separated.pieces)
+          FillOutline(ball, cv::Point(), &balls_mask);
+        cv::dilate(balls_mask, balls_mask, cv::Mat(), cv::Point(-1, -1), 2);
         cv::Mat rest = blob_mask.clone();
-        rest.setTo(0, disc_mask);
+        rest.setTo(0, balls_mask);
         // Slivers along the rim (the outline outside the circle, a highlight's edge) are the
         // ball's: what is thinner than a seventh of its radius goes.
-        const int k = std::max(3, static_cast<int>(0.15 * disc_radius_px) | 1);
+        const int k = std::max(3, static_cast<int>(0.15 * ball_radius_px) | 1);
         cv::morphologyEx(rest, rest, cv::MORPH_OPEN,
                          cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
-        for (cv::Point& p : disc) p -= window.tl();
-        separated.pieces.push_back(std::move(disc));
         std::vector<std::vector<cv::Point>> parts;
         FindOuterContours(rest, &parts);
-        // What is left goes on as pieces of its own, not cut further (cut at its concave
-        // defects, Toss Up's arena views lost groups, 0.682 -> 0.667 of 66, measured with
-        // min_disc_outline 0.6).
         for (std::vector<cv::Point>& part : parts) {
           if (cv::contourArea(part) >= options.min_area_px) {
             separated.pieces.push_back(std::move(part));
           }
         }
+      };
+      if (!disc.empty()) {
+        ++st.semi_discs;
+        for (cv::Point& p : disc) p -= window.tl();
+        separated.pieces.push_back(std::move(disc));
+        add_rest(disc_radius_px);
       } else if (sized.objects > 1) {
         separated.pieces = std::move(sized.pieces);
       } else if (convex) {
@@ -1129,10 +1176,10 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       } else {
         separated = SeparateTouching(blob_mask, options.separation, options.separation_options);
       }
-      const bool split = separated.pieces.size() > 1;
+      bool split = separated.pieces.size() > 1;
       const bool by_size = sized.objects > 1;
       // Left whole: the one piece is the blob's own outline (convex, or nothing to cut).
-      const bool whole =
+      bool whole =
           convex ||
           (separated.pieces.size() == 1 &&
            std::equal(
@@ -1140,18 +1187,76 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                [&](const cv::Point& b, const cv::Point& p) { return b == p + window.tl(); }));
       // The blob's own outline (not cuts, not the image border): where arcs of objects show.
       // Not needed for a blob left whole: every point of its piece is on the outline.
+      const auto blob_outline = [&]() {
+        cv::Mat out(window.size(), CV_8UC1, cv::Scalar(0));
+        for (const cv::Point& p : blob) out.at<uint8_t>(p - window.tl()) = 255;
+        DilateLike(out, cv::Mat(), &out);  // 3x3: a piece's outline may shift by a pixel
+        return out;
+      };
       cv::Mat outline;
-      if (all_round && !whole && !by_size) {
-        outline = cv::Mat(window.size(), CV_8UC1, cv::Scalar(0));
-        for (const cv::Point& p : blob) outline.at<uint8_t>(p - window.tl()) = 255;
-        DilateLike(outline, cv::Mat(), &outline);  // 3x3: a piece's outline may shift by a pixel
+      if (all_round && !whole && !by_size) outline = blob_outline();
+      // Round objects: a circle through the visible arcs of a piece's outline (image
+      // coordinates) gives the centre and radius even when a cut, another object or the image
+      // border hides part of it; nothing when no circle fits them.
+      const auto fit_arc = [&](const std::vector<cv::Point>& piece,
+                               double area_px) -> std::optional<ArcFit> {
+        std::vector<cv::Point> arc;
+        for (const cv::Point& p : piece) {
+          const cv::Point local = p - window.tl();
+          const bool on_border = p.x <= 1 || p.y <= 1 || p.x >= bgr.cols - 2 || p.y >= bgr.rows - 2;
+          if (!on_border && (whole || outline.at<uint8_t>(local))) arc.push_back(p);
+        }
+        double inliers = 0.0;
+        std::optional<ArcFit> fit = FitArc(arc, &inliers);
+        if (!fit || inliers < options.min_arc_inlier_fraction ||
+            fit->rms > options.max_arc_rms_ratio * fit->radius ||
+            fit->coverage_deg < options.min_arc_coverage_deg ||
+            fit->radius > 2.0 * std::sqrt(area_px / M_PI) + 2.0) {
+          return std::nullopt;
+        }
+        return fit;
+      };
+      // A semi-transparent ball the cut took apart (notched where what lies behind shows
+      // through it) or left whole but ragged: when a piece of the blob fits no circle, the
+      // blob's depth may lie on the front of a ball (or two) of the kind's size that explains
+      // it and fills its disc in the image; those balls are then the pieces, and the rest of
+      // the blob goes on apart. (Asked only when a piece fits no circle: most blobs are balls
+      // the cut parts well, and the depth's test costs.)
+      const double semi_px =
+          semi_kind ? focal * semi_kind->radius_m / (blob_depth_m + semi_kind->surface_to_centre_m)
+                    : 0.0;
+      if (semi_kind && options.semi_sphere_pieces && have_depth && blob_depth_m > 0.0 &&
+          disc.empty() && !by_size && all_round &&
+          blob_area >= options.semi_sphere_min_area * M_PI * semi_px * semi_px &&
+          std::any_of(separated.pieces.begin(), separated.pieces.end(),
+                      [&](const std::vector<cv::Point>& local) {
+                        std::vector<cv::Point> piece = local;
+                        for (cv::Point& p : piece) p += window.tl();
+                        const double area = cv::contourArea(piece);
+                        return area >= options.min_area_px && !fit_arc(piece, area);
+                      })) {
+        SphereSplitResult balls =
+            SplitSpheres(blob_mask, depth_mm(window), window.tl(), *setup.camera,
+                         semi_kind->radius_m, options.semi_sphere_split);
+        if (balls.objects >= 1 &&
+            BallsFillDiscs(balls, semi_kind->radius_m, *setup.camera, blob_mask, window.tl(),
+                           bgr.size(), options.semi_sphere_min_fill)) {
+          ++st.semi_spheres;
+          separated.pieces = std::move(balls.pieces);
+          for (size_t b = 0; b < separated.pieces.size(); ++b) piece_kinds[b] = semi_kind;
+          add_rest(semi_px);
+          split = separated.pieces.size() > 1;
+          whole = false;
+          if (outline.empty()) outline = blob_outline();  // for the rest's arcs
+        }
       }
       // Pieces from a piece of the cut that no circle fits, split by the balls' centres, are
       // appended from here on.
       const size_t first_ball_piece = separated.pieces.size();
       for (size_t piece_index = 0; piece_index < separated.pieces.size(); ++piece_index) {
         std::vector<cv::Point> piece = separated.pieces[piece_index];
-        const bool piece_sized = by_size || piece_index >= first_ball_piece;
+        const bool piece_sized =
+            by_size || piece_index >= first_ball_piece || piece_kinds.count(piece_index) > 0;
         ++st.pieces;
         for (cv::Point& p : piece) p += window.tl();
         Detection d;
@@ -1167,21 +1272,28 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
         d.circularity = perimeter > 0.0 ? 4.0 * M_PI * d.area_px / (perimeter * perimeter) : 0.0;
         d.box = cv::boundingRect(piece);
         if (all_round && !piece_sized) {
-          // Round objects: a circle through the visible arcs of the outline gives the centre
-          // and radius even when a cut, another object or the image border hides part of it.
-          std::vector<cv::Point> arc;
-          for (const cv::Point& p : piece) {
-            const cv::Point local = p - window.tl();
-            const bool on_border =
-                p.x <= 1 || p.y <= 1 || p.x >= bgr.cols - 2 || p.y >= bgr.rows - 2;
-            if (!on_border && (whole || outline.at<uint8_t>(local))) arc.push_back(p);
-          }
-          double inliers = 0.0;
-          const std::optional<ArcFit> fit = FitArc(arc, &inliers);
-          if (!fit || inliers < options.min_arc_inlier_fraction ||
-              fit->rms > options.max_arc_rms_ratio * fit->radius ||
-              fit->coverage_deg < options.min_arc_coverage_deg ||
-              fit->radius > 2.0 * std::sqrt(d.area_px / M_PI) + 2.0) {
+          const std::optional<ArcFit> fit = fit_arc(piece, d.area_px);
+          if (!fit) {
+            // Balls of a size in the piece, by their centres (vision/sphere_split.h), as pieces
+            // of their own from here on (of `kind`, when given).
+            const cv::Rect bounds =
+                (d.box + cv::Size(4, 4) - cv::Point(2, 2)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+            cv::Mat piece_mask;
+            const auto balls_in_piece = [&](double radius_m, const SphereSplitOptions& split) {
+              if (piece_mask.empty()) {
+                piece_mask = cv::Mat(bounds.size(), CV_8UC1, cv::Scalar(0));
+                FillOutline(piece, -bounds.tl(), &piece_mask);
+              }
+              return SplitSpheres(piece_mask, depth_mm(bounds), bounds.tl(), *setup.camera,
+                                  radius_m, split);
+            };
+            const auto add_balls = [&](SphereSplitResult* balls, const TargetKind* kind) {
+              for (std::vector<cv::Point>& ball : balls->pieces) {
+                for (cv::Point& p : ball) p += bounds.tl() - window.tl();
+                if (kind) piece_kinds[separated.pieces.size()] = kind;
+                separated.pieces.push_back(std::move(ball));
+              }
+            };
             // Two balls or more that the cut left together (one behind another, or beside
             // a larger object of their colour the whole blob's split could not explain).
             const double piece_ball_px =
@@ -1190,20 +1302,25 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                                 : 0.0;
             if (piece_ball_kind && have_depth &&
                 d.area_px >= options.sphere_split_min_area * M_PI * piece_ball_px * piece_ball_px) {
-              const cv::Rect bounds =
-                  (d.box + cv::Size(4, 4) - cv::Point(2, 2)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
-              cv::Mat piece_mask(bounds.size(), CV_8UC1, cv::Scalar(0));
-              FillOutline(piece, -bounds.tl(), &piece_mask);
               SphereSplitResult balls =
-                  SplitSpheres(piece_mask, depth_mm(bounds), bounds.tl(), *setup.camera,
-                               piece_ball_kind->radius_m, options.sphere_split);
+                  balls_in_piece(piece_ball_kind->radius_m, options.sphere_split);
               if (balls.objects > 1) {
                 ++st.split_spheres;
-                for (std::vector<cv::Point>& ball : balls.pieces) {
-                  for (cv::Point& p : ball) p += bounds.tl() - window.tl();
-                  separated.pieces.push_back(std::move(ball));
-                }
+                add_balls(&balls, nullptr);
                 continue;  // split, not rejected
+              }
+            }
+            // A semi-transparent ball: its depth on the front of one ball of its size.
+            if (semi_kind && options.semi_sphere_pieces && have_depth && blob_depth_m > 0.0 &&
+                d.area_px >= options.semi_sphere_min_area * M_PI * semi_px * semi_px) {
+              SphereSplitResult balls =
+                  balls_in_piece(semi_kind->radius_m, options.semi_sphere_split);
+              if (balls.objects >= 1 &&
+                  BallsFillDiscs(balls, semi_kind->radius_m, *setup.camera, piece_mask, bounds.tl(),
+                                 bgr.size(), options.semi_sphere_min_fill)) {
+                ++st.semi_spheres;
+                add_balls(&balls, semi_kind);
+                continue;  // found, not rejected
               }
             }
             ++st.rejected_shape;
@@ -1316,6 +1433,8 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
                 }
               }
             }
+            if (const auto known = piece_kinds.find(piece_index); known != piece_kinds.end())
+              best = known->second;
             if (options.drop_too_tall && !piece_sized && !best->round) {
               // Taller than the kind can stand, on its edge (its width) or in the tallest
               // stack the season places: an upright bar or panel of its colour.

@@ -49,16 +49,20 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
     if (seen >= 32 && low < (options.min_explained - 0.2) * seen) return result;
   }
   const cv::Mat core = RimlessCore(mask, options.erode_px, options.min_points);
+  // Every pixel_step-th pixel of every pixel_step-th row is looked at: counts of pixels
+  // (points on a ball, the fewest a ball needs) are of those.
+  const int pixel_step = std::max(1, options.pixel_step);
+  const int min_points = std::max(3, options.min_points / (pixel_step * pixel_step));
   // The blob's points in the robot frame (z up from the floor), where a ball can be: from the
   // floor to its top, with the tolerance either side.
   std::vector<cv::Point> pixels;
   std::vector<Eigen::Vector3d> points;
   int with_depth = 0;               // every point of the blob, wherever it lies
   std::vector<double> slack_at_cm;  // noise_sigmas x sigma, per centimetre of depth
-  for (int v = 0; v < core.rows; ++v) {
+  for (int v = 0; v < core.rows; v += pixel_step) {
     const uint8_t* m = core.ptr<uint8_t>(v);
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
-    for (int u = 0; u < core.cols; ++u) {
+    for (int u = 0; u < core.cols; u += pixel_step) {
       if (!m[u] || !d[u]) continue;
       const double z = camera.CorrectDepthM(d[u]);
       if (!(z > 0.0)) continue;
@@ -80,7 +84,7 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
   // structure, a larger ball of the colour), and no ball is looked for; nor when its top is
   // below a ball's centre (a floor marking: the camera, above the balls, sees every ball's
   // top).
-  if (static_cast<int>(points.size()) < options.min_points ||
+  if (static_cast<int>(points.size()) < min_points ||
       static_cast<double>(points.size()) < options.min_explained * with_depth) {
     return result;
   }
@@ -159,7 +163,7 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
   std::vector<int> owner(points.size(), -1);
   std::vector<double> tols;  // each ball's surface tolerance
   std::vector<size_t> support;
-  const double min_votes = static_cast<double>(options.min_points) / stride;
+  const double min_votes = static_cast<double>(min_points) / stride;
   int rejected_in_a_row = 0;
   for (int tries = 0; tries < 4 * options.max_objects && result.objects < options.max_objects;
        ++tries) {
@@ -198,8 +202,9 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
       if (owner[i] < 0 && std::abs((points[i] - c).norm() - r) <= ball_tol) support.push_back(i);
     }
     const double range = (c - eye).norm();
-    const double whole_px = M_PI * std::pow(focal * r / std::max(range, r), 2);
-    bool ball = static_cast<int>(support.size()) >= options.min_points &&
+    const double whole_px =
+        M_PI * std::pow(focal * r / std::max(range, r), 2) / (pixel_step * pixel_step);
+    bool ball = static_cast<int>(support.size()) >= min_points &&
                 static_cast<double>(support.size()) >= options.min_support * whole_px;
     if (ball && options.min_curve_ratio > 0.0) {
       // Its points curve as a ball's do: a plane through them fits worse than the sphere by
@@ -239,8 +244,8 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
     }
   }
 
-  // One ball or none: nothing to split (not looked at further).
-  if (result.objects < 2) {
+  // Fewer balls than asked for (one or none, to split): nothing (not looked at further).
+  if (result.objects < std::max(1, options.min_objects)) {
     result.centres.clear();
     return result;
   }
@@ -277,6 +282,32 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
     }
     label.at<int>(pixels[i]) = on < 0 ? -2 : on;
   }
+  // The pixels not looked at (pixel_step > 1), with depth where a ball can be: the nearest
+  // sphere's, if on it, as the others.
+  for (int v = 0; v < core.rows && pixel_step > 1; ++v) {
+    const uint8_t* m = core.ptr<uint8_t>(v);
+    const uint16_t* d = depth_mm.ptr<uint16_t>(v);
+    for (int u = 0; u < core.cols; ++u) {
+      if ((v % pixel_step == 0 && u % pixel_step == 0) || !m[u] || !d[u]) continue;
+      const double z = camera.CorrectDepthM(d[u]);
+      if (!(z > 0.0)) continue;
+      const Eigen::Vector3d p = robot_point(u, v, z);
+      if (p.z() < -tol || p.z() > 2.0 * r + tol) {  // where no ball can be, as above
+        const size_t cm = static_cast<size_t>(z * 100.0);
+        if (cm >= slack_at_cm.size()) slack_at_cm.resize(cm + 1, -1.0);
+        if (slack_at_cm[cm] < 0.0)
+          slack_at_cm[cm] = options.noise_sigmas * camera.DepthSigmaM((cm + 1) / 100.0);
+        if (p.z() < -slack_at_cm[cm] || p.z() > 2.0 * r + slack_at_cm[cm]) continue;
+      }
+      int on = -2;
+      double best = std::numeric_limits<double>::infinity();
+      for (int b = 0; b < result.objects; ++b) {
+        const double e = std::abs((p - result.centres[b]).norm() - r);
+        if (e <= tols[b] && e < best) best = e, on = b;
+      }
+      label.at<int>(v, u) = on;
+    }
+  }
   cv::Mat free_px(mask.size(), CV_8UC1, cv::Scalar(255));  // 0 where a ball's pixel is
   for (int v = 0; v < mask.rows; ++v) {
     for (int u = 0; u < mask.cols; ++u) {
@@ -284,10 +315,18 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
     }
   }
   cv::Mat dist, nearest;
-  cv::distanceTransform(free_px, dist, nearest, cv::DIST_L2, 3, cv::DIST_LABEL_PIXEL);
+  // One ball: every pixel near a ball's is its (no labels to look up).
+  const bool one = result.objects == 1;
+  if (one) {
+    // The mask the labelled transform uses for DIST_L2 (OpenCV takes 5 x 5 there), so that
+    // the distances are the same.
+    cv::distanceTransform(free_px, dist, cv::DIST_L2, cv::DIST_MASK_5);
+  } else {
+    cv::distanceTransform(free_px, dist, nearest, cv::DIST_L2, 3, cv::DIST_LABEL_PIXEL);
+  }
   // Each zero pixel's label index -> its ball.
   std::vector<int> ball_of_index(1, -1);
-  for (int v = 0; v < mask.rows; ++v) {
+  for (int v = 0; v < mask.rows && !one; ++v) {
     for (int u = 0; u < mask.cols; ++u) {
       if (!free_px.at<uint8_t>(v, u)) {
         const int index = nearest.at<int>(v, u);
@@ -303,6 +342,10 @@ SphereSplitResult SplitSpheres(const cv::Mat& mask, const cv::Mat& depth_mm, cv:
     for (int u = 0; u < mask.cols; ++u) {
       if (!mask.at<uint8_t>(v, u) || label.at<int>(v, u) == -2) continue;
       if (dist.at<float>(v, u) > reach) continue;
+      if (one) {
+        groups[0].at<uint8_t>(v, u) = 255;
+        continue;
+      }
       const int index = nearest.at<int>(v, u);
       const int b = index < static_cast<int>(ball_of_index.size()) ? ball_of_index[index] : -1;
       if (b >= 0) groups[b].at<uint8_t>(v, u) = 255;

@@ -44,10 +44,17 @@ struct SphereSplitOptions {
   int max_objects = 40;
   int max_rejections = 8;  // peaks in a row that are no ball end the search
   int erode_px = 1;        // the blob's rim (depth there may see past the ball) is left out
+  // Fewest balls returned as pieces: 2 splits a blob; 1 also finds one ball alone (a
+  // semi-transparent ball whose ragged outline no circle fits), checked against the blob as
+  // two or more are.
+  int min_objects = 2;
+  // Every n-th pixel of every n-th row of the blob is looked at (1: all): a large ball near
+  // the camera covers tens of thousands of pixels, and a few thousand place it as well.
+  int pixel_step = 1;
 };
 
-// Two balls or more: a piece and a centre each. One or none (`objects` 0 or 1): nothing to
-// split, no pieces (the one ball is not checked against the blob).
+// Two balls or more (options.min_objects or more): a piece and a centre each. Fewer: nothing
+// to split, no pieces (a single ball is then not checked against the blob).
 struct SphereSplitResult {
   std::vector<std::vector<cv::Point>> pieces;  // one external contour per ball, mask pixels
   std::vector<Eigen::Vector3d> centres;        // robot frame, metres, one per piece

@@ -40,6 +40,7 @@ struct EvalArgs {
   bool no_supports = false;
   bool no_sliver_drop = false;
   bool no_semi_discs = false;
+  bool no_semi_spheres = false;
 };
 
 int RunVision(const EvalArgs& args) {
@@ -68,6 +69,7 @@ int RunVision(const EvalArgs& args) {
   options.detect.size_split.rest_on_supports = !args.no_supports;
   if (args.no_sliver_drop) options.detect.size_split.sliver_fraction = 0.0;
   if (args.no_semi_discs) options.detect.min_disc_fill = 0.0;
+  if (args.no_semi_spheres) options.detect.semi_sphere_pieces = false;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
       throw std::invalid_argument("--pile MIN,MAX: MIN must not exceed MAX");
@@ -174,6 +176,10 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
                    "separate a semi-transparent ball's blob like any other (at its concave "
                    "defects, or by watershed) even when its outline is a circle it fills (the "
                    "detector before, for comparison)");
+  vision->add_flag("--no-semi-spheres", args->no_semi_spheres,
+                   "reject a semi-transparent ball's blob or piece that no circle fits, however "
+                   "well its depth fits one ball of its size (the detector before, for "
+                   "comparison)");
   vision->add_option("--pictures", args->pictures,
                      "write annotated views of the 12 worst frames (detections, misses, false "
                      "and off-field detections) here");
