@@ -861,10 +861,14 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
     const bool all_round =
         std::all_of(kinds.begin(), kinds.end(), [](const TargetKind& k) { return k.round; });
     const bool semi_round = all_round && !all_solid;  // a semi-transparent ball among them
-    // The semi-transparent ball among them (the largest, if more than one).
+    // The semi-transparent ball among them (the largest, if more than one), for the depth's
+    // test of a ragged one (DetectOptions::semi_sphere_pieces; K-Means only, unless asked).
     const TargetKind* semi_kind = nullptr;
-    for (const TargetKind& k : kinds) {
-      if (k.round && !k.solid && (!semi_kind || k.radius_m > semi_kind->radius_m)) semi_kind = &k;
+    if (options.semi_sphere_pieces &&
+        (options.method == DetectMethod::kKMeans || options.semi_sphere_threshold)) {
+      for (const TargetKind& k : kinds) {
+        if (k.round && !k.solid && (!semi_kind || k.radius_m > semi_kind->radius_m)) semi_kind = &k;
+      }
     }
 
     std::vector<std::vector<cv::Point>> blobs;
@@ -1225,8 +1229,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
       const double semi_px =
           semi_kind ? focal * semi_kind->radius_m / (blob_depth_m + semi_kind->surface_to_centre_m)
                     : 0.0;
-      if (semi_kind && options.semi_sphere_pieces && have_depth && blob_depth_m > 0.0 &&
-          disc.empty() && !by_size && all_round &&
+      if (semi_kind && have_depth && blob_depth_m > 0.0 && disc.empty() && !by_size && all_round &&
           blob_area >= options.semi_sphere_min_area * M_PI * semi_px * semi_px &&
           std::any_of(separated.pieces.begin(), separated.pieces.end(),
                       [&](const std::vector<cv::Point>& local) {
@@ -1311,7 +1314,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               }
             }
             // A semi-transparent ball: its depth on the front of one ball of its size.
-            if (semi_kind && options.semi_sphere_pieces && have_depth && blob_depth_m > 0.0 &&
+            if (semi_kind && have_depth && blob_depth_m > 0.0 &&
                 d.area_px >= options.semi_sphere_min_area * M_PI * semi_px * semi_px) {
               SphereSplitResult balls =
                   balls_in_piece(semi_kind->radius_m, options.semi_sphere_split);

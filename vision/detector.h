@@ -76,6 +76,11 @@ struct DetectOptions {
   // kind's size that explain it and fill their discs in the image; the rest of the blob goes
   // on apart. Tried again on a piece that fits no circle (a ball beside others of its colour).
   bool semi_sphere_pieces = true;
+  // ... with K-Means, the method for semi-transparent objects (the thesis's), only; with the
+  // HSV threshold too when set. Off by default: the threshold is the speed path (#17's goal,
+  // README "Speed"), and on the benchmark's Toss Up view, full of large balls near the camera,
+  // the step took it 2.9 -> 4.5 ms (K-Means 7.2 -> 7.4 ms).
+  bool semi_sphere_threshold = false;
   double semi_sphere_min_area = 0.3;  // ... for blobs at least this x the ball's whole area
   // ... and whose mask covers at least this share of each ball's disc as the camera sees it
   // (two buckyballs one above another explain the front of a large ball's sphere too).

@@ -41,6 +41,7 @@ struct EvalArgs {
   bool no_sliver_drop = false;
   bool no_semi_discs = false;
   bool no_semi_spheres = false;
+  bool semi_spheres_threshold = false;
 };
 
 int RunVision(const EvalArgs& args) {
@@ -70,6 +71,7 @@ int RunVision(const EvalArgs& args) {
   if (args.no_sliver_drop) options.detect.size_split.sliver_fraction = 0.0;
   if (args.no_semi_discs) options.detect.min_disc_fill = 0.0;
   if (args.no_semi_spheres) options.detect.semi_sphere_pieces = false;
+  if (args.semi_spheres_threshold) options.detect.semi_sphere_threshold = true;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
       throw std::invalid_argument("--pile MIN,MAX: MIN must not exceed MAX");
@@ -180,6 +182,9 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
                    "reject a semi-transparent ball's blob or piece that no circle fits, however "
                    "well its depth fits one ball of its size (the detector before, for "
                    "comparison)");
+  vision->add_flag("--semi-spheres-threshold", args->semi_spheres_threshold,
+                   "find semi-transparent balls by their depth with the HSV threshold too, not "
+                   "only with K-Means (slower on views full of them)");
   vision->add_option("--pictures", args->pictures,
                      "write annotated views of the 12 worst frames (detections, misses, false "
                      "and off-field detections) here");

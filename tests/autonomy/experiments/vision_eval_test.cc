@@ -533,20 +533,30 @@ TEST(VisionEvalTest, SemiTransparentBallsAreNotCutWhereThingsShowThrough) {
 // A semi-transparent ball whose blob no circle fits (ragged where the background shows
 // through it, cut apart at its notches, or clipped by the image's edge) is found by its depth:
 // on the front of one ball of the kind's size, filling half its disc in the image
-// (DetectOptions::semi_sphere_pieces). Measured on these 20 arena views (`slamo eval vision
-// --season toss_up --arena --frames 20 --seed 1 [--no-semi-spheres]`), without -> with:
-// semi-transparent recall +0.04 to +0.26 per method (kmeans+defects 0.745 -> 0.784,
-// threshold+defects 0.373 -> 0.569), groups counted right +1 to +4 of 15, false detections
-// the same in every method. The test asks for two balls more per method, a group more, and
-// no false detection more.
+// (DetectOptions::semi_sphere_pieces), with K-Means, and with the threshold when asked
+// (semi_sphere_threshold). Measured on these 20 arena views (`slamo eval vision --season
+// toss_up --arena --frames 20 --seed 1 [--no-semi-spheres | --semi-spheres-threshold]`),
+// without -> with: semi-transparent recall +0.04 to +0.26 per method (kmeans+defects 0.745
+// -> 0.784, threshold+defects 0.373 -> 0.569), groups counted right +1 to +4 of 15, false
+// detections the same in every method. The test asks for two balls more per method, a group
+// more, and no false detection more; and, not asked, the threshold's methods the same.
 TEST(VisionEvalTest, SemiTransparentBallsAreFoundByTheirDepth) {
   VisionEvalOptions without;
   without.detect.semi_sphere_pieces = false;
-  CompareInArena("toss_up", 20, {}, without,
+  VisionEvalOptions with;
+  with.detect.semi_sphere_threshold = true;
+  CompareInArena("toss_up", 20, with, without,
                  [](const VisionMethodScore& a, const VisionMethodScore& b) {
                    EXPECT_GE(a.found_semi, b.found_semi + 2);
                    EXPECT_GE(a.groups_counted, b.groups_counted + 1);
                    EXPECT_LE(a.false_positives, b.false_positives);
+                 });
+  CompareInArena("toss_up", 20, {}, without,
+                 [](const VisionMethodScore& a, const VisionMethodScore& b) {
+                   if (a.name.rfind("threshold", 0) != 0) return;
+                   EXPECT_EQ(a.found, b.found);
+                   EXPECT_EQ(a.false_positives, b.false_positives);
+                   EXPECT_EQ(a.groups_counted, b.groups_counted);
                  });
 }
 
