@@ -557,6 +557,18 @@ bool ClearFloatingRuns(std::vector<uint8_t> support, int min_run, int max_gap, c
   return cleared;
 }
 
+// The smallest apparent radius (pixels) of the kinds with a size, each seen `depth_m` in front
+// of the camera (its visible surface there); infinity when none has one.
+double SmallestApparentRadiusPx(const std::vector<TargetKind>& kinds, double focal_px,
+                                double depth_m) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const TargetKind& k : kinds) {
+    if (k.radius_m > 0.0)
+      smallest = std::min(smallest, focal_px * k.radius_m / (depth_m + k.surface_to_centre_m));
+  }
+  return smallest;
+}
+
 // An object resting on the floor seen without depth: each kind has a range on the ground plane
 // (the plane of its centre); the kind whose apparent size fits best at its own range, within
 // the size tolerance, sets the detection's kind and measurement. False when none fits.
@@ -959,11 +971,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               expected_radius_px =
                   std::max(expected_radius_px, focal * k.radius_m / (z + k.surface_to_centre_m));
           }
-          double smallest = std::numeric_limits<double>::infinity();
-          for (const TargetKind& k : kinds) {
-            if (k.radius_m > 0.0)
-              smallest = std::min(smallest, focal * k.radius_m / (z + k.surface_to_centre_m));
-          }
+          const double smallest = SmallestApparentRadiusPx(kinds, focal, z);
           if (std::isfinite(smallest) &&
               blob_area < options.min_expected_area_ratio * M_PI * smallest * smallest) {
             ++st.rejected_small;
@@ -1378,12 +1386,7 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
             if (piece_sized && options.min_sized_area_ratio > 0.0) {
               // ... but not a strip of its rim under a tenth of the smallest kind's area at
               // its depth (mixed readings there cluster apart on the floor).
-              double smallest = std::numeric_limits<double>::infinity();
-              for (const TargetKind& k : kinds) {
-                if (k.radius_m > 0.0)
-                  smallest = std::min(
-                      smallest, focal * k.radius_m / (surface->depth_m + k.surface_to_centre_m));
-              }
+              const double smallest = SmallestApparentRadiusPx(kinds, focal, surface->depth_m);
               if (std::isfinite(smallest) &&
                   d.area_px < options.min_sized_area_ratio * M_PI * smallest * smallest) {
                 ++st.rejected_small;
