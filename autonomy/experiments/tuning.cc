@@ -93,6 +93,8 @@ const std::map<std::string, std::string>& TunableParams() {
        "plans no second cycle on what that drive pushes on; 0: neither"},
       {"reverse_max",
        "path legs behind the robot up to this long (m) are driven backwards (0: never)"},
+      {"corner_merge",
+       "two path corners closer than this (m) become one where the legs meet (0: never)"},
       {"pushable", "objects narrower than this fraction of the robot are pushed, not avoided"},
       {"arrival_frames", "planner: frames to check an arrival"},
       {"observe_first", "planner: 1 weighs observing before a cycle (frames 5, 10, 20); 0 never"},
@@ -157,6 +159,8 @@ void ApplyParam(const std::string& name, const std::string& value, MatchSetup* s
     setup->strategy_options.count_push_loss = ToFlag(name, value);
   } else if (name == "reverse_max") {
     setup->reverse_max_m = ToDouble(name, value);
+  } else if (name == "corner_merge") {
+    setup->corner_merge_m = ToDouble(name, value);
   } else if (name == "pushable") {
     setup->pushable_fraction = ToDouble(name, value);
   } else if (name == "arrival_frames") {

@@ -75,6 +75,10 @@ struct MatchSetup {
   // Path legs behind the robot up to this long are driven backwards instead of turning round
   // twice (0: always forwards).
   double reverse_max_m = 0.6;
+  // Two interior path corners closer than this become one (where the legs before and after
+  // meet, else their midpoint, else either corner) when the legs to and from it are clear: a
+  // few-centimetre leg between two turns is two stops for one bend (0: never).
+  double corner_merge_m = 0.15;
   bool gyro =
       true;  // the turn of every motion from a yaw gyro, not the encoders (VEX robots carry one)
   bool adaptive_filter = false;  // the EKF's adaptive noise (mapping::AdaptiveOptions)
@@ -263,6 +267,8 @@ class MatchWorld {
   void UpdateMaps();
   void Init(uint64_t seed);
   bool PathClear(const std::vector<Eigen::Vector2d>& path) const;
+  // setup_.corner_merge_m on a path's corners (its ends stay).
+  void MergeCloseCorners(std::vector<Eigen::Vector2d>* corners) const;
   double ObjectRadius(const std::string& kind) const;
 
   field::SeasonConfig field_;  // the season with this match's object placement
