@@ -1404,6 +1404,24 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               const double ratio = std::max(d.radius_px / expected, expected / d.radius_px);
               if (ratio < best_ratio) best_ratio = ratio, best = &k;
             }
+            if (!best && options.flat_side_pieces && !piece_sized) {
+              // The side of a flat kind whose top is hidden: by its width and its height.
+              for (const TargetKind& k : kinds) {
+                if (k.round || k.radius_m <= 0.0 || k.centre_height_m <= 0.0 ||
+                    4.0 * k.centre_height_m >= 2.0 * k.radius_m) {
+                  continue;
+                }
+                const double at_m = surface->depth_m + k.surface_to_centre_m;
+                const double width_px = focal * 2.0 * k.radius_m / at_m;
+                const double thick_px = focal * 2.0 * k.centre_height_m / at_m;
+                const double w = d.box.width, h = d.box.height;
+                const double ratio = std::max(w / width_px, width_px / w);
+                if (ratio < best_ratio && h >= 0.5 * thick_px &&
+                    h <= options.size_tolerance * thick_px) {
+                  best_ratio = ratio, best = &k;
+                }
+              }
+            }
             if (!best) {
               ++st.rejected_size;
               continue;

@@ -41,6 +41,7 @@ struct EvalArgs {
   bool no_sliver_drop = false;
   bool no_semi_discs = false;
   bool no_semi_spheres = false;
+  bool no_flat_sides = false;
   bool semi_spheres_threshold = false;
 };
 
@@ -71,6 +72,7 @@ int RunVision(const EvalArgs& args) {
   if (args.no_sliver_drop) options.detect.size_split.sliver_fraction = 0.0;
   if (args.no_semi_discs) options.detect.min_disc_fill = 0.0;
   if (args.no_semi_spheres) options.detect.semi_sphere_pieces = false;
+  if (args.no_flat_sides) options.detect.flat_side_pieces = false;
   if (args.semi_spheres_threshold) options.detect.semi_sphere_threshold = true;
   if (!args.pile.empty()) {
     if (args.pile[0] > args.pile[1])
@@ -182,6 +184,10 @@ void RegisterEvalCommand(CLI::App& app, CommandAction* action) {
                    "reject a semi-transparent ball's blob or piece that no circle fits, however "
                    "well its depth fits one ball of its size (the detector before, for "
                    "comparison)");
+  vision->add_flag("--no-flat-sides", args->no_flat_sides,
+                   "reject a piece too small by its area for a ring (a flat kind) even when its "
+                   "width and height are a ring's seen from the side, its top hidden (the "
+                   "detector before, for comparison)");
   vision->add_flag("--semi-spheres-threshold", args->semi_spheres_threshold,
                    "find semi-transparent balls by their depth with the HSV threshold too, not "
                    "only with K-Means (slower on views full of them)");

@@ -502,6 +502,55 @@ TEST(LandmarkDetectionTest, FindsTheMarkersOnTheFarWall) {
   EXPECT_LE(found.size(), truth.landmarks.size());  // nothing else taken for a marker
 }
 
+// High Stakes' stack of two beside the ladder, a red ring on a blue one, seen by the V5 robot's
+// camera 0.8 m away: the blue ring shows only its side under the red (a band as wide as a ring
+// and as tall as one, too small by its area for a ring seen whole). Both are found, each at its
+// own height; before, the blue was refused by its size and the planner's picks of the red ring
+// took the blue one under it (the intake meets the bottom ring first).
+TEST(StackedRingsTest, TheLowerRingOfAStackOfTwoColoursIsFoundBySide) {
+  const field::SeasonConfig season = field::LoadSeasonConfig("high_stakes");
+  const field::RobotConfig robot = field::LoadRobotConfig("v5_drivetrain");
+  const platform::SimWorld world = platform::CreateWorld(season, 1);
+  platform::SimRenderer renderer(season, robot.camera, platform::RenderOptions{}, 1);
+  const platform::Pose2D pose{-0.37, 0.25, 195.0 * M_PI / 180.0};
+  const platform::RgbdFrame frame = renderer.Render(world, pose, 0.0, nullptr);
+  const DetectorSetup setup = ObjectDetectorSetup(season, &robot.camera);
+  // The stack's rings, bottom first.
+  std::vector<const SimObject*> stack;
+  for (const SimObject& o : world.objects) {
+    if (o.type->name == "ring" &&
+        (o.center_m.head<2>() - Eigen::Vector2d(-1.196, 0.0)).norm() < 0.05)
+      stack.push_back(&o);
+  }
+  std::sort(stack.begin(), stack.end(), [](const SimObject* a, const SimObject* b) {
+    return a->center_m.z() < b->center_m.z();
+  });
+  ASSERT_EQ(stack.size(), 2u);
+  ASSERT_EQ(stack[0]->colour, "blue");
+  ASSERT_EQ(stack[1]->colour, "red");
+  // The detections of `colour` within 6 cm of the stack (through the true pose), by height.
+  const auto at_stack = [&](const DetectOptions& options, const std::string& colour) {
+    std::vector<double> heights;
+    for (const Detection& d : Detect(frame.colour, frame.depth_mm, setup, options)) {
+      if (d.colour != colour || !d.measurement) continue;
+      const Eigen::Vector3d& p = d.measurement->position_robot_m;
+      const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+      const Eigen::Vector2d at(pose.x_m + c * p.x() - s * p.y(), pose.y_m + s * p.x() + c * p.y());
+      if ((at - stack[0]->center_m.head<2>()).norm() < 0.06) heights.push_back(p.z());
+    }
+    return heights;
+  };
+  const std::vector<double> blue = at_stack({}, "blue"), red = at_stack({}, "red");
+  ASSERT_EQ(blue.size(), 1u);
+  ASSERT_EQ(red.size(), 1u);
+  EXPECT_NEAR(blue[0], stack[0]->center_m.z(), 0.02);
+  EXPECT_NEAR(red[0], stack[1]->center_m.z(), 0.02);
+  DetectOptions by_area;
+  by_area.flat_side_pieces = false;
+  EXPECT_TRUE(at_stack(by_area, "blue").empty());
+  EXPECT_EQ(at_stack(by_area, "red").size(), 1u);
+}
+
 // The readings under a mask, sixteen pixels at a time where it can: the same readings, in the
 // same order, as one pixel at a time. Masks of runs (whole chunks set, whole chunks clear, and
 // chunks of both), depth with holes, boxes of any size and views into larger images.
