@@ -544,8 +544,11 @@ void MatchWorld::MergeCloseCorners(std::vector<Eigen::Vector2d>* corners) const 
     if (std::abs(cross) > 1e-9) {
       const Eigen::Vector2d w = c[i + 1] - c[i - 1];
       const Eigen::Vector2d meet = c[i - 1] + in * ((w.x() * out.y() - w.y() * out.x()) / cross);
-      // Nearly parallel legs meet far away: that corner would be a detour, not a merge.
-      if ((meet - middle).norm() <= 2.0 * setup_.corner_merge_m) candidates.push_back(meet);
+      // Nearly parallel legs meet far away, and legs that meet behind the leg before or past
+      // the leg after would make a detour, not a merge.
+      if ((meet - middle).norm() <= 2.0 * setup_.corner_merge_m &&
+          (meet - c[i - 1]).dot(in) > 0.0 && (c[i + 2] - meet).dot(out) > 0.0)
+        candidates.push_back(meet);
     }
     candidates.insert(candidates.end(), {middle, c[i], c[i + 1]});
     bool merged = false;
