@@ -1404,7 +1404,10 @@ std::vector<Detection> Detect(const cv::Mat& bgr, const cv::Mat& depth_mm,
               const double ratio = std::max(d.radius_px / expected, expected / d.radius_px);
               if (ratio < best_ratio) best_ratio = ratio, best = &k;
             }
-            if (!best && options.flat_side_pieces && !piece_sized) {
+            // (Not a piece the image's edge cuts: its box is not the object's.)
+            const bool at_edge = d.box.x <= 0 || d.box.y <= 0 || d.box.br().x >= bgr.cols ||
+                                 d.box.br().y >= bgr.rows;
+            if (!best && options.flat_side_pieces && !piece_sized && !at_edge) {
               // The side of a flat kind whose top is hidden: by its width and its height.
               for (const TargetKind& k : kinds) {
                 if (k.round || k.radius_m <= 0.0 || k.centre_height_m <= 0.0 ||

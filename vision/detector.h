@@ -38,8 +38,9 @@ struct DetectOptions {
   double size_tolerance = 1.8;  // with depth: apparent radius within [1/x, x] of an object's
   // With depth, a piece too small by its area for every kind is a flat kind (thinner than
   // half its width: a ring) seen from the side when its width fits the kind's apparent width
-  // and its height at least half the kind's apparent thickness (both within size_tolerance):
-  // the lower ring of a stack of two colours, whose top the ring on it hides.
+  // (within size_tolerance) and its height is 0.5 to size_tolerance x the kind's apparent
+  // thickness, and the image's edge does not cut it: the lower ring of a stack of two
+  // colours, whose top the ring on it hides.
   bool flat_side_pieces = true;
   // With depth, a piece split off by the objects' size (or the balls' centres) below this x
   // the smallest kind's apparent area at its depth is a strip of a rim, not an object. 0: off.
